@@ -1,0 +1,183 @@
+// The discrete flow map (METHOD.md §3): from initial data (p_0 .. p_{2k-1}, g~_0 .. g~_{2k-2},
+// λ^0 .. λ^{k-1}) the steps n = k .. N-k produce p_{2k} .. p_N, g~_{2k-1} .. g~_{N-1} and
+// λ^k .. λ^{N-k}. Optionally propagates the sensitivity of the state (in tangent coordinates)
+// with respect to any set of directions of the initial state.
+#pragma once
+
+#include "step.hpp"
+
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+namespace lpshoot {
+
+// A discrete reduced trajectory on the grid t_n = n h (n = 0..N).
+template <class P>
+struct Trajectory {
+  double h = 0;
+  std::vector<Vec<double, P::shape_dim>> p;            // p_0 .. p_N
+  std::vector<GroupElement<P, double>> g;              // g~_0 .. g~_{N-1}
+  std::vector<Vec<double, P::num_constraints>> lam;    // λ^0 .. λ^{N-k}
+  int N() const { return static_cast<int>(p.size()) - 1; }
+  double time(int n) const { return n * h; }
+
+  // The flow state before step n (nodes n-k .. n+k-1).
+  FlowState<P> state(int n) const {
+    constexpr int k = P::order;
+    FlowState<P> s;
+    for (int i = 0; i < 2 * k; ++i) s.p[i] = p[n - k + i];
+    for (int i = 0; i < 2 * k - 1; ++i) s.g[i] = g[n - k + i];
+    for (int j = 0; j < k; ++j) s.lam[j] = lam[n - k + j];
+    return s;
+  }
+};
+
+enum class FlowStatus { Ok, NotConverged, Singular, NonFinite, InvalidInput };
+
+struct FlowReport {
+  FlowStatus status = FlowStatus::Ok;
+  std::string message;      // empty when Ok; names the failed step otherwise
+  int failed_step = -1;
+  int steps = 0;            // steps completed
+  int total_iterations = 0;
+  int max_iterations = 0;
+  double max_residual = 0;
+  double max_condition = 0;
+  std::vector<StepReport> step_reports;  // one per attempted step
+  bool ok() const { return status == FlowStatus::Ok; }
+};
+
+template <class P>
+struct FlowResult {
+  Trajectory<P> trajectory;  // up to the last completed step
+  FlowReport report;
+  // d(final state)/d(initial directions), Dims<P>::state x q, when a seed was given.
+  Eigen::MatrixXd sensitivity;
+};
+
+template <class P>
+class DiscreteFlow {
+ public:
+  using D = Dims<P>;
+  DiscreteFlow(const P& problem, double h, NewtonOptions options = {})
+      : problem_(problem), h_(h), options_(options) {}
+
+  const P& problem() const { return problem_; }
+  double h() const { return h_; }
+
+  // Runs to node N (steps n = k .. N-k). `seed` (state x q, optional) gives the initial
+  // directions whose sensitivity is propagated to the final state.
+  FlowResult<P> run(const FlowState<P>& initial, int N, const Eigen::MatrixXd* seed = nullptr) const {
+    constexpr int k = D::k, r = D::r, d = D::d, m = D::m, ns = D::state;
+    FlowResult<P> out;
+    Trajectory<P>& tr = out.trajectory;
+    FlowReport& rep = out.report;
+    tr.h = h_;
+    if (N < 2 * k - 1 || !(h_ > 0)) {
+      rep.status = FlowStatus::InvalidInput;
+      rep.message = "the flow needs h > 0 and N >= 2k-1 = " + std::to_string(2 * k - 1) +
+                    " (got h = " + format_number(h_) + ", N = " + std::to_string(N) + ")";
+      return out;
+    }
+    if (seed && seed->rows() != ns) {
+      rep.status = FlowStatus::InvalidInput;
+      rep.message = "sensitivity seed has " + std::to_string(seed->rows()) + " rows, expected " +
+                    std::to_string(ns);
+      return out;
+    }
+    tr.p.assign(initial.p.begin(), initial.p.end());
+    tr.g.assign(initial.g.begin(), initial.g.end());
+    tr.lam.assign(initial.lam.begin(), initial.lam.end());
+    tr.p.reserve(N + 1);
+    tr.g.reserve(N);
+    tr.lam.reserve(N - k + 1);
+    rep.step_reports.reserve(std::max(0, N - 2 * k + 1));
+    if (seed) out.sensitivity = *seed;
+
+    FlowState<P> s = initial;
+    Eigen::MatrixXd next;
+    for (int n = k; n <= N - k; ++n) {
+      StepUnknowns<P> z;
+      StepReport sr = solve_step(problem_, h_, s, n, options_, z);
+      rep.step_reports.push_back(sr);
+      rep.total_iterations += sr.iterations;
+      rep.max_iterations = std::max(rep.max_iterations, sr.iterations);
+      rep.max_residual = std::max(rep.max_residual, sr.residual);
+      rep.max_condition = std::max(rep.max_condition, sr.condition);
+      if (sr.status != StepStatus::Converged) {
+        rep.status = sr.status == StepStatus::Singular    ? FlowStatus::Singular
+                     : sr.status == StepStatus::NonFinite ? FlowStatus::NonFinite
+                                                          : FlowStatus::NotConverged;
+        rep.message = sr.message;
+        rep.failed_step = n;
+        return out;
+      }
+      if (seed) {
+        // New state = shifted old state + z; the new rows come from the implicit function theorem.
+        const Eigen::Matrix<double, D::unknowns, ns> dz = step_sensitivity(problem_, h_, s, z);
+        const Eigen::MatrixXd dzS = dz * out.sensitivity;
+        const Eigen::MatrixXd& S = out.sensitivity;
+        next.resize(ns, S.cols());
+        using FS = FlowState<P>;
+        next.middleRows(FS::p_offset(0), (2 * k - 1) * r) = S.middleRows(FS::p_offset(1), (2 * k - 1) * r);
+        next.middleRows(FS::p_offset(2 * k - 1), r) = dzS.topRows(r);
+        next.middleRows(FS::g_offset(0), (2 * k - 2) * d) = S.middleRows(FS::g_offset(1), (2 * k - 2) * d);
+        next.middleRows(FS::g_offset(2 * k - 2), d) = dzS.middleRows(r, d);
+        next.middleRows(FS::lam_offset(0), (k - 1) * m) = S.middleRows(FS::lam_offset(1), (k - 1) * m);
+        next.middleRows(FS::lam_offset(k - 1), m) = dzS.bottomRows(m);
+        out.sensitivity.swap(next);
+      }
+      // Shift the state and store the new unknowns.
+      for (int i = 0; i + 1 < 2 * k; ++i) s.p[i] = s.p[i + 1];
+      s.p[2 * k - 1] = z.p;
+      for (int i = 0; i + 1 < 2 * k - 1; ++i) s.g[i] = s.g[i + 1];
+      s.g[2 * k - 2] = z.g;
+      for (int j = 0; j + 1 < k; ++j) s.lam[j] = s.lam[j + 1];
+      s.lam[k - 1] = z.lam;
+      tr.p.push_back(z.p);
+      tr.g.push_back(z.g);
+      tr.lam.push_back(z.lam);
+      ++rep.steps;
+    }
+    return out;
+  }
+
+ private:
+  P problem_;
+  double h_;
+  NewtonOptions options_;
+};
+
+// Moves a state along tangent coordinates: p += δp, g~ <- g~ exp(δ), λ += δλ.
+template <class P>
+FlowState<P> retract(const FlowState<P>& s, const Vec<double, Dims<P>::state>& delta) {
+  using G = typename P::Group;
+  using FS = FlowState<P>;
+  constexpr int k = P::order, r = P::shape_dim, d = G::dim, m = P::num_constraints;
+  FlowState<P> out = s;
+  for (int i = 0; i < 2 * k; ++i) out.p[i] += delta.template segment<r>(FS::p_offset(i));
+  for (int i = 0; i < 2 * k - 1; ++i) {
+    const typename G::template Tangent<double> xi = delta.template segment<d>(FS::g_offset(i));
+    out.g[i] = G::compose(out.g[i], G::template exp<double>(xi));
+  }
+  for (int j = 0; j < k; ++j) out.lam[j] += delta.template segment<m>(FS::lam_offset(j));
+  return out;
+}
+
+// Tangent coordinates of a relative to b: the δ with retract(b, δ) = a (log of b^{-1} a).
+template <class P>
+Vec<double, Dims<P>::state> state_difference(const FlowState<P>& a, const FlowState<P>& b) {
+  using G = typename P::Group;
+  using FS = FlowState<P>;
+  constexpr int k = P::order, r = P::shape_dim, d = G::dim, m = P::num_constraints;
+  Vec<double, Dims<P>::state> delta;
+  for (int i = 0; i < 2 * k; ++i) delta.template segment<r>(FS::p_offset(i)) = a.p[i] - b.p[i];
+  for (int i = 0; i < 2 * k - 1; ++i)
+    delta.template segment<d>(FS::g_offset(i)) = G::log(G::compose(G::inverse(b.g[i]), a.g[i]));
+  for (int j = 0; j < k; ++j) delta.template segment<m>(FS::lam_offset(j)) = a.lam[j] - b.lam[j];
+  return delta;
+}
+
+}  // namespace lpshoot

@@ -1,0 +1,100 @@
+// The problem contract (METHOD.md §1).
+//
+// A user describes a discrete reduced problem with one struct:
+//
+//   struct MyProblem {
+//     using Group = lpshoot::SE2;                 // the symmetry group G
+//     static constexpr int shape_dim = 1;         // r, dimension of the shape space Q/G
+//     static constexpr int order = 2;             // k >= 1
+//     static constexpr int num_constraints = 3;   // m >= 0
+//     template <class T> T lagrangian(const lpshoot::Window<MyProblem, T>& a, double h) const;
+//     template <class T> lpshoot::Vec<T, 3> constraints(const lpshoot::Window<MyProblem, T>& a,
+//                                                       double h) const;     // when m > 0
+//     template <class T> Group::Element<T> connection(const lpshoot::Vec<T, 1>& p0,
+//                                                     const lpshoot::Vec<T, 1>& p1) const;
+//   };                                                                        // optional: A = e
+//
+// A window a_n = (p_n .. p_{n+k}, g~_n .. g~_{n+k-1}) (paper eq. 45). The functions are
+// templated on the scalar so that the engine can differentiate them; they must be written
+// with T arithmetic only (use value(x) for branches).
+#pragma once
+
+#include "dual.hpp"
+#include "groups.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <type_traits>
+#include <utility>
+
+namespace lpshoot {
+
+template <class T, int N>
+using Vec = Eigen::Matrix<T, N, 1>;
+
+template <class P>
+struct Dims {
+  using Group = typename P::Group;
+  static constexpr int r = P::shape_dim;        // shape
+  static constexpr int d = Group::dim;          // group
+  static constexpr int m = P::num_constraints;  // constraints (multipliers per window)
+  static constexpr int k = P::order;
+  static constexpr int node = r + d;            // variations of one node: (δp, η)
+  static constexpr int unknowns = r + d + m;    // one flow step: (p_{n+k}, ζ, λ^n)
+  // Flow state before step n: p_{n-k} .. p_{n+k-1}, g~_{n-k} .. g~_{n+k-2}, λ^{n-k} .. λ^{n-1}.
+  static constexpr int state = 2 * k * r + (2 * k - 1) * d + k * m;
+  static_assert(k >= 1, "order k must be at least 1");
+  static_assert(r >= 1, "the shape space must have dimension at least 1");
+  static_assert(m >= 0, "num_constraints must be non-negative");
+};
+
+template <class P, class T>
+using GroupElement = typename P::Group::template Element<T>;
+
+template <class P, class T>
+struct Window {
+  std::array<Vec<T, P::shape_dim>, P::order + 1> p;
+  std::array<GroupElement<P, T>, P::order> g;
+};
+
+namespace detail {
+template <class P, class T, class = void>
+struct HasConnection : std::false_type {};
+template <class P, class T>
+struct HasConnection<P, T,
+                     std::void_t<decltype(std::declval<const P&>().template connection<T>(
+                         std::declval<const Vec<T, P::shape_dim>&>(),
+                         std::declval<const Vec<T, P::shape_dim>&>()))>> : std::true_type {};
+}  // namespace detail
+
+// A(p0, p1): the user's discrete connection, or the identity for a trivial bundle.
+template <class P, class T>
+GroupElement<P, T> connection(const P& problem, const Vec<T, P::shape_dim>& p0,
+                              const Vec<T, P::shape_dim>& p1) {
+  if constexpr (detail::HasConnection<P, T>::value) {
+    return problem.template connection<T>(p0, p1);
+  } else {
+    (void)problem, (void)p0, (void)p1;
+    return P::Group::template identity<T>();
+  }
+}
+
+template <class P>
+constexpr bool has_connection() {
+  return detail::HasConnection<P, double>::value;
+}
+
+// L~(a, λ) = L_d(a) + λ · chi_d(a)  (paper eq. 47).
+template <class P, class T>
+T augmented_lagrangian(const P& problem, const Window<P, T>& a, const Vec<T, P::num_constraints>& lam,
+                       double h) {
+  T L = problem.template lagrangian<T>(a, h);
+  if constexpr (P::num_constraints > 0) {
+    const Vec<T, P::num_constraints> chi = problem.template constraints<T>(a, h);
+    for (int i = 0; i < P::num_constraints; ++i) L = L + lam(i) * chi(i);
+  }
+  return L;
+}
+
+}  // namespace lpshoot

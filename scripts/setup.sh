@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages lpshoot needs, with apt-get as root (through sudo when not
+# root), and only those that are missing. Prints what it installs.
+set -euo pipefail
+
+packages=(
+  g++ cmake make ccache pkg-config
+  libeigen3-dev                      # Eigen 3.4
+  libsundials-dev                    # SUNDIALS 6.4 (KINSOL)
+  libnlopt-dev libnlopt-cxx-dev      # NLopt 2.7
+  libboost-dev                       # Boost 1.74 (Odeint)
+  libgtest-dev libbenchmark-dev      # GoogleTest, Google Benchmark
+  libcli11-dev nlohmann-json3-dev    # the application
+  gnuplot-nox                        # plots
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all required Debian packages are installed"
+  exit 0
+fi
+
+echo "setup: installing Debian packages with apt-get (as root): ${missing[*]}"
+sudo=""
+if [ "$(id -u)" != 0 ]; then
+  command -v sudo >/dev/null || { echo "setup: not root and no sudo; install as root: apt-get install ${missing[*]}" >&2; exit 1; }
+  sudo="sudo"
+fi
+$sudo apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+echo "setup: done"

@@ -1,0 +1,51 @@
+// Initial data for the tests: the paper's systems started from continuous-looking data.
+#pragma once
+
+#include <lpshoot/problems/beanie.hpp>
+#include <lpshoot/problems/electron.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace lpshoot::test_support {
+
+using problems::BeanieControl;
+using problems::BeanieFree;
+using problems::BeanieParameters;
+
+// Free beanie from q(0) and q'(0): q_1 = q_0 + h q'(0).
+inline FlowState<BeanieFree> beanie_free_initial(const BeanieParameters& par, const Eigen::Vector4d& q0,
+                                                 const Eigen::Vector4d& v0, double h) {
+  const Eigen::Vector4d q1 = q0 + h * v0;
+  FlowState<BeanieFree> s;
+  s.p = {Vec<double, 1>(q0(3)), Vec<double, 1>(q1(3))};
+  s.g = {problems::beanie_increment(par, q0, q1)};
+  return s;
+}
+
+// k = 2 beanie control: ψ_0..ψ_3 given, g~_0 = (h Ω3, h Ω12), g~_1, g~_2 from the constraints
+// chi(a_0) = chi(a_1) = 0 of the chosen variant, λ^0 and λ^1 given.
+inline FlowState<BeanieControl> beanie_control_initial(const BeanieControl& b, const std::array<double, 4>& psi,
+                                                       const Eigen::Vector3d& Omega, const Eigen::Vector3d& lam0,
+                                                       const Eigen::Vector3d& lam1, double h) {
+  FlowState<BeanieControl> s;
+  for (int i = 0; i < 4; ++i) s.p[i] = Vec<double, 1>(psi[i]);
+  s.g[0] = {h * Omega(2), h * Omega.head<2>()};
+  for (int i = 1; i < 3; ++i) {
+    const double beta = s.g[i - 1].angle - b.par.c() * (psi[i] - psi[i - 1]);
+    Eigen::Matrix2d J;
+    J << 0, -1, 1, 0;
+    const Eigen::Matrix2d rot = b.variant == problems::BeanieConstraints::ExactRotation
+                                    ? SO2::rotation(-beta)
+                                    : Eigen::Matrix2d(Eigen::Matrix2d::Identity() - beta * J);
+    s.g[i] = {s.g[i - 1].angle, rot * s.g[i - 1].t};
+  }
+  s.lam = {lam0, lam1};
+  return s;
+}
+
+inline double max_abs_diff(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  return (a - b).lpNorm<Eigen::Infinity>();
+}
+
+}  // namespace lpshoot::test_support

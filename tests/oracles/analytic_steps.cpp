@@ -1,0 +1,124 @@
+#include "oracles/analytic_steps.hpp"
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+
+namespace lpshoot::oracles {
+
+namespace {
+Eigen::Vector3d electron_U(const Electron& e, const Eigen::Vector3d& x0, const Eigen::Vector3d& x1,
+                           const Eigen::Vector3d& x2, double h) {
+  return e.mass * (x2 - 2 * x1 + x0) / (h * h) + 2 * e.potential * x0 - e.e_over_c * ((x1 - x0) / h).cross(e.B);
+}
+Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& b) {
+  Eigen::Matrix3d K;
+  K << 0, -b(2), b(1), b(2), 0, -b(0), -b(1), b(0), 0;
+  return K;
+}
+}  // namespace
+
+Eigen::Vector3d electron_stencil_residual(const Electron& e, const std::array<Eigen::Vector3d, 5>& xs, double h) {
+  // Component i of node j = n-2 .. n+2 is xs[j - n + 2](i).
+  auto x = [&](int i, int off) { return xs[off + 2](i); };
+  const double m = e.mass, w = e.e_over_c * e.B(2) / m, k = e.potential;
+  auto D4 = [&](int i) { return (x(i, 2) - 4 * x(i, 1) + 6 * x(i, 0) - 4 * x(i, -1) + x(i, -2)) / std::pow(h, 4); };
+  auto D3b = [&](int i) { return (x(i, 1) - 3 * x(i, 0) + 3 * x(i, -1) - x(i, -2)) / std::pow(h, 3); };
+  auto D3f = [&](int i) { return (x(i, 2) - 3 * x(i, 1) + 3 * x(i, 0) - x(i, -1)) / std::pow(h, 3); };
+  auto D2 = [&](int i, int c) { return (x(i, c + 1) - 2 * x(i, c) + x(i, c - 1)) / (h * h); };
+  auto D1b = [&](int i) { return (x(i, 0) - x(i, -1)) / h; };
+  auto D1f = [&](int i) { return (x(i, 1) - x(i, 0)) / h; };
+  // The paper's φ = |x|^2 gives the 2/m and 4/m^2 coefficients; a general potential κ|x|^2
+  // scales them by κ and κ^2.
+  auto common = [&](int i) { return -(2 * k / m) * (D2(i, -1) + D2(i, 1)) - 4 * k * k * x(i, 0) / (m * m); };
+  Eigen::Vector3d r;
+  r(0) = D4(0) - (w * (D3b(1) + D3f(1)) + w * w * D2(0, 0) + common(0) + (2 * k * w / m) * (D1b(1) + D1f(1)));
+  r(1) = D4(1) - (-w * (D3b(0) + D3f(0)) + w * w * D2(1, 0) + common(1) - (2 * k * w / m) * (D1b(0) + D1f(0)));
+  r(2) = D4(2) - common(2);
+  return r;
+}
+
+Eigen::Vector3d electron_analytic_residual(const Electron& e, const std::array<Eigen::Vector3d, 5>& x, double h) {
+  const Eigen::Vector3d U0 = electron_U(e, x[0], x[1], x[2], h);  // U_{n-2}
+  const Eigen::Vector3d U1 = electron_U(e, x[1], x[2], x[3], h);  // U_{n-1}
+  const Eigen::Vector3d U2 = electron_U(e, x[2], x[3], x[4], h);  // U_n
+  return (e.mass / h) * (U0 - 2 * U1 + U2) + 2 * e.potential * h * U2 + e.e_over_c * e.B.cross(U2 - U1);
+}
+
+Eigen::Vector3d electron_analytic_step(const Electron& e, const std::array<Eigen::Vector3d, 4>& x, double h) {
+  // [(m/h + 2κh) I + (e/c)[B×]] U_n = (m/h)(2U_{n-1} - U_{n-2}) + (e/c) B × U_{n-1}.
+  const Eigen::Vector3d U0 = electron_U(e, x[0], x[1], x[2], h);
+  const Eigen::Vector3d U1 = electron_U(e, x[1], x[2], x[3], h);
+  const Eigen::Matrix3d A = (e.mass / h + 2 * e.potential * h) * Eigen::Matrix3d::Identity() +
+                            e.e_over_c * cross_matrix(e.B);
+  const Eigen::Vector3d rhs = (e.mass / h) * (2 * U1 - U0) + e.e_over_c * e.B.cross(U1);
+  const Eigen::Vector3d U2 = A.inverse() * rhs;
+  // U_n = m (x_{n+2} - 2x_{n+1} + x_n)/h^2 + 2κ x_n - (e/c) ((x_{n+1} - x_n)/h) × B.
+  const Eigen::Vector3d known = 2 * e.potential * x[2] - e.e_over_c * ((x[3] - x[2]) / h).cross(e.B);
+  return (h * h / e.mass) * (U2 - known) + 2 * x[3] - x[2];
+}
+
+// Derivation (window j: ψ_j, ψ_{j+1}, ψ_{j+2}, g~_j = (ω_j, t_j), g~_{j+1}; β_j = ω_j - cΔψ_j):
+//   u_j = μ Δ²ψ_j / h^2 + V'(ψ_{j+1}),  L^_j = (h/2) u_j^2,
+//   χ_j = ((t_{j+1} - Rot(β_j) t_j)/h, (ω_{j+1} - ω_j)/h), Rot(β) = R(-β) or I - βJ.
+// The connection moves ω_{n-1} by +c δψ and ω_n by -c δψ, leaving β unchanged, so the χ terms
+// of the ψ-equation cancel except the ω-differences:
+//   E_ψ = (μ/h)(u_{n-2} - 2u_{n-1} + u_n) + h V''(ψ_n) u_{n-1} + (c/h)(λ3^{n-2} - 2λ3^{n-1} + λ3^n).
+// With μ^R(F) = (∂F/∂t, ∂F/∂ω + ∂F/∂t · J t) for SE(2) = (ω, t):
+//   P_j = (λ12^{j-1} - Rot(β_j)^T λ12^j)/h,  Q_j = (λ3^{j-1} - λ3^j)/h - λ12^j · Rot'(β_j) t_j / h,
+//   M_j = (P_j, Q_j + P_j · J t_j), and E_η = Ad*_{W_{n-1}} M_{n-1} - M_n with W_{n-1} = (β_{n-1}, t_{n-1}).
+StepUnknowns<BeanieControl> beanie_control_analytic_step(const BeanieControl& b, const FlowState<BeanieControl>& s,
+                                                         double h) {
+  using Eigen::Matrix2d;
+  using Eigen::Vector2d;
+  const BeanieParameters& par = b.par;
+  const double c = par.c(), mu = par.mu();
+  const bool exact = b.variant == problems::BeanieConstraints::ExactRotation;
+  Matrix2d J;
+  J << 0, -1, 1, 0;
+  auto rot = [&](double beta) -> Matrix2d {
+    return exact ? SO2::rotation(-beta) : Matrix2d(Matrix2d::Identity() - beta * J);
+  };
+  auto drot = [&](double beta) -> Matrix2d { return exact ? Matrix2d(-J * SO2::rotation(-beta)) : Matrix2d(-J); };
+  auto psi = [&](int i) { return s.p[i](0); };  // ψ_{n-2+i}
+  auto ddV = [&](double x) { return par.amplitude * std::cos(x); };
+  auto u = [&](int i) { return mu * (psi(i + 2) - 2 * psi(i + 1) + psi(i)) / (h * h) + par.dV(psi(i + 1)); };
+  // Local increments: s.g[0] = g~_{n-2}, s.g[1] = g~_{n-1}, s.g[2] = g~_n; s.lam[0] = λ^{n-2}, s.lam[1] = λ^{n-1}.
+  auto beta = [&](int i) { return s.g[i].angle - c * (psi(i + 1) - psi(i)); };
+  const Vector2d l12_0 = s.lam[0].head<2>(), l12_1 = s.lam[1].head<2>();
+  const double l3_0 = s.lam[0](2), l3_1 = s.lam[1](2);
+
+  // M_{n-1} (increment g~_{n-1}: windows n-2 and n-1).
+  const double b1 = beta(1), b2 = beta(2);
+  const Vector2d t1 = s.g[1].t, t2 = s.g[2].t;
+  const Vector2d P1 = (l12_0 - rot(b1).transpose() * l12_1) / h;
+  const double Q1 = (l3_0 - l3_1) / h - l12_1.dot(drot(b1) * t1) / h;
+  const Eigen::Vector3d M1(P1(0), P1(1), Q1 + P1.dot(J * t1));
+  // Target M_n = Ad*_{W_{n-1}} M_{n-1}, W_{n-1} = (β_{n-1}, t_{n-1}).
+  const Eigen::Vector3d Mn = SE2::Ad<double>({b1, t1}).transpose() * M1;
+  const Vector2d Pn = Mn.head<2>();
+  const double Qn = Mn(2) - Pn.dot(J * t2);
+  StepUnknowns<BeanieControl> z;
+  const Vector2d l12_n = rot(b2).transpose().inverse() * (l12_1 - h * Pn);
+  const double Gn = -l12_n.dot(drot(b2) * t2) / h;
+  const double l3_n = l3_1 + h * (Gn - Qn);
+  z.lam << l12_n, l3_n;
+
+  const double un = 2 * u(1) - u(0) - (h * h / mu) * ddV(psi(2)) * u(1) - (c / mu) * (l3_0 - 2 * l3_1 + l3_n);
+  z.p(0) = h * h * (un - par.dV(psi(3))) / mu + 2 * psi(3) - psi(2);
+  z.g = {s.g[2].angle, rot(b2) * t2};
+  return z;
+}
+
+Eigen::Vector4d beanie_unreduced_step(const BeanieParameters& par, const Eigen::Vector4d& q_prev,
+                                      const Eigen::Vector4d& q, double h) {
+  const Eigen::Vector4d dq = q - q_prev;
+  const double c = par.c();
+  const double dpsi = dq(3) - h * h * par.dV(q(3)) / par.mu();
+  const double s = dq(2) + c * dq(3);  // Δθ + cΔψ, conserved
+  Eigen::Vector4d next;
+  next << q(0) + dq(0), q(1) + dq(1), q(2) + s - c * dpsi, q(3) + dpsi;
+  return next;
+}
+
+}  // namespace lpshoot::oracles

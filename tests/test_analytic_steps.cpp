@@ -1,0 +1,63 @@
+// The engine's derived step against hand-solved steps of the same schemes (the oracles that are
+// also the benchmark baselines): the electron and the k = 2 beanie control, both constraint sets.
+#include "helpers.hpp"
+#include "oracles/analytic_steps.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace lpshoot;
+using problems::BeanieConstraints;
+using problems::BeanieControl;
+using problems::Electron;
+
+TEST(AnalyticSteps, ElectronFlowMatchesHandSolvedStep) {
+  const Electron e{1.0, 1.0, Eigen::Vector3d(0, 0, 1.0), 1.0};
+  const double h = 0.01;
+  const int N = 400;
+  FlowState<Electron> s;
+  const Eigen::Vector3d x0(1, 0, 0.5), v0(0, 1, -0.2), a0(0.3, -0.1, 0.2);
+  for (int i = 0; i < 4; ++i) s.p[i] = x0 + i * h * v0 + 0.5 * (i * h) * (i * h) * a0;
+  const auto res = DiscreteFlow<Electron>(e, h).run(s, N);
+  ASSERT_TRUE(res.report.ok()) << res.report.message;
+  std::vector<Eigen::Vector3d> x(s.p.begin(), s.p.end());
+  for (int n = 2; n + 2 <= N; ++n) x.push_back(oracles::electron_analytic_step(e, {x[n - 2], x[n - 1], x[n], x[n + 1]}, h));
+  double diff = 0, scale = 0;
+  for (int n = 0; n <= N; ++n) {
+    diff = std::max(diff, (x[n] - res.trajectory.p[n]).lpNorm<Eigen::Infinity>());
+    scale = std::max(scale, x[n].lpNorm<Eigen::Infinity>());
+  }
+  std::printf("electron: engine vs hand-solved over %d steps: %.2e (max |x| %.2f)\n", N, diff, scale);
+  // A k = 2 recursion amplifies roundoff like N^4 eps (METHOD.md §5): 400^4 * 2.2e-16 = 5.6e-6
+  // is the bound; both are the same scheme, so they stay much closer.
+  EXPECT_LT(diff, 1e-8 * scale);
+}
+
+TEST(AnalyticSteps, BeanieControlStepMatchesHandSolvedStep) {
+  for (auto variant : {BeanieConstraints::ExactRotation, BeanieConstraints::Paper}) {
+    for (double amplitude : {0.0, 1.0}) {
+      BeanieControl b;
+      b.par = {1.2, 0.8, 0.6, amplitude};
+      b.variant = variant;
+      const double h = 0.02;
+      auto s = test_support::beanie_control_initial(b, {0.4, 0.43, 0.47, 0.52}, Eigen::Vector3d(0.5, 0.2, -0.7),
+                                               Eigen::Vector3d(0.2, -0.1, 0.3), Eigen::Vector3d(0.25, -0.05, 0.2),
+                                               h);
+      const DiscreteFlow<BeanieControl> flow(b, h);
+      const auto res = flow.run(s, 200);
+      ASSERT_TRUE(res.report.ok()) << res.report.message;
+      double dp = 0, dg = 0, dl = 0;
+      for (int n = 2; n <= 200 - 2; ++n) {
+        const auto st = res.trajectory.state(n);
+        const auto z = oracles::beanie_control_analytic_step(b, st, h);
+        dp = std::max(dp, std::abs(z.p(0) - res.trajectory.p[n + 2](0)));
+        const auto& g = res.trajectory.g[n + 1];
+        dg = std::max(dg, std::max(std::abs(z.g.angle - g.angle), (z.g.t - g.t).lpNorm<Eigen::Infinity>()));
+        dl = std::max(dl, (z.lam - res.trajectory.lam[n]).lpNorm<Eigen::Infinity>() /
+                              std::max(1.0, z.lam.lpNorm<Eigen::Infinity>()));
+      }
+      EXPECT_LT(dp, 1e-12) << "psi";
+      EXPECT_LT(dg, 1e-14) << "increment";
+      EXPECT_LT(dl, 1e-9) << "multipliers";
+    }
+  }
+}
