@@ -23,13 +23,17 @@ inline FlowState<BeanieFree> beanie_free_initial(const BeanieParameters& par, co
   return s;
 }
 
-// k = 2 beanie control: ψ_0..ψ_3 given, g~_0 = (h Ω3, h Ω12), g~_1, g~_2 from the constraints
+// k = 2 beanie control: ψ_i = ψ(0) + ψ'(0) t_i + ψ''(0) t_i^2/2 for i = 0..3, g~_0 = (h Ω3, h Ω12), g~_1, g~_2 from the constraints
 // chi(a_0) = chi(a_1) = 0 of the chosen variant, λ^0 and λ^1 given.
-inline FlowState<BeanieControl> beanie_control_initial(const BeanieControl& b, const std::array<double, 4>& psi,
+inline FlowState<BeanieControl> beanie_control_initial(const BeanieControl& b, const Eigen::Vector3d& psi_data,
                                                        const Eigen::Vector3d& Omega, const Eigen::Vector3d& lam0,
                                                        const Eigen::Vector3d& lam1, double h) {
   FlowState<BeanieControl> s;
-  for (int i = 0; i < 4; ++i) s.p[i] = Vec<double, 1>(psi[i]);
+  std::array<double, 4> psi;
+  for (int i = 0; i < 4; ++i) {
+    psi[i] = psi_data(0) + psi_data(1) * i * h + 0.5 * psi_data(2) * (i * h) * (i * h);
+    s.p[i] = Vec<double, 1>(psi[i]);
+  }
   s.g[0] = {h * Omega(2), h * Omega.head<2>()};
   for (int i = 1; i < 3; ++i) {
     const double beta = s.g[i - 1].angle - b.par.c() * (psi[i] - psi[i - 1]);

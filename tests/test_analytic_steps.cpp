@@ -39,8 +39,8 @@ TEST(AnalyticSteps, BeanieControlStepMatchesHandSolvedStep) {
       b.par = {1.2, 0.8, 0.6, amplitude};
       b.variant = variant;
       const double h = 0.02;
-      auto s = test_support::beanie_control_initial(b, {0.4, 0.43, 0.47, 0.52}, Eigen::Vector3d(0.5, 0.2, -0.7),
-                                               Eigen::Vector3d(0.2, -0.1, 0.3), Eigen::Vector3d(0.25, -0.05, 0.2),
+      auto s = test_support::beanie_control_initial(b, Eigen::Vector3d(0.4, 0.8, -0.5), Eigen::Vector3d(0.5, 0.2, -0.7),
+                                               Eigen::Vector3d(0.2, -0.1, 0.3), Eigen::Vector3d(0.201, -0.098, 0.302),
                                                h);
       const DiscreteFlow<BeanieControl> flow(b, h);
       const auto res = flow.run(s, 200);

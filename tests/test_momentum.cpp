@@ -54,9 +54,9 @@ TEST(Momentum, ControlFlowWithNonzeroMultipliersConservesMomentum) {
     b.variant = variant;
     const double h = 0.01;
     const int N = 600;
-    const auto init = test_support::beanie_control_initial(b, {0.5, 0.51, 0.525, 0.545}, Eigen::Vector3d(0.8, -0.3, 0.6),
+    const auto init = test_support::beanie_control_initial(b, Eigen::Vector3d(0.5, 0.8, -0.5), Eigen::Vector3d(0.8, -0.3, 0.6),
                                                       Eigen::Vector3d(0.3, -0.2, 0.1),
-                                                      Eigen::Vector3d(0.31, -0.19, 0.12), h);
+                                                      Eigen::Vector3d(0.302, -0.199, 0.101), h);
     const auto res = DiscreteFlow<BeanieControl>(b, h).run(init, N);
     ASSERT_TRUE(res.report.ok()) << res.report.message;
     const auto J = spatial_momentum(b, res.trajectory, SE2::Element<double>{0.2, Eigen::Vector2d(1.0, -1.0)});
@@ -79,9 +79,9 @@ TEST(Momentum, ExactRotationKeepsOmegaNormsAndPaperConstraintsDoNot) {
     b.variant = variant;
     const double h = 0.01;
     const int N = 600;
-    const auto init = test_support::beanie_control_initial(b, {0.5, 0.51, 0.525, 0.545}, Eigen::Vector3d(0.8, -0.3, 0.6),
+    const auto init = test_support::beanie_control_initial(b, Eigen::Vector3d(0.5, 0.8, -0.5), Eigen::Vector3d(0.8, -0.3, 0.6),
                                                       Eigen::Vector3d(0.3, -0.2, 0.1),
-                                                      Eigen::Vector3d(0.31, -0.19, 0.12), h);
+                                                      Eigen::Vector3d(0.302, -0.199, 0.101), h);
     const auto res = DiscreteFlow<BeanieControl>(b, h).run(init, N);
     ASSERT_TRUE(res.report.ok()) << res.report.message;
     double lo = 1e300, hi = 0, w_spread = 0;
