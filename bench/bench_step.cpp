@@ -1,1 +1,103 @@
-int main() { return 0; }
+// One flow step: the engine's derived step (automatic differentiation of the local action,
+// Newton with the exact Jacobian) against a hand-written analytic step of the same scheme
+// (tests/oracles, which the tests also check against the engine).
+//   ./build/bench/bench_step --benchmark_repetitions=7 --benchmark_report_aggregates_only=true
+#include "oracles/analytic_steps.hpp"
+
+#include <benchmark/benchmark.h>
+
+using namespace lpshoot;
+using problems::BeanieControl;
+using problems::Electron;
+
+namespace {
+FlowState<BeanieControl> beanie_state(const BeanieControl& b, double h) {
+  FlowState<BeanieControl> s;
+  for (int i = 0; i < 4; ++i) s.p[i] = Vec<double, 1>(0.5 + 0.8 * i * h - 0.25 * (i * h) * (i * h));
+  s.g[0] = {0.6 * h, Eigen::Vector2d(0.8 * h, -0.3 * h)};
+  for (int i = 1; i < 3; ++i) {
+    const double beta = s.g[i - 1].angle - b.par.c() * (s.p[i](0) - s.p[i - 1](0));
+    s.g[i] = {s.g[i - 1].angle, SO2::rotation(-beta) * s.g[i - 1].t};
+  }
+  s.lam = {Eigen::Vector3d(0.3, -0.2, 0.1), Eigen::Vector3d(0.302, -0.199, 0.101)};
+  return s;
+}
+
+BeanieControl beanie() {
+  BeanieControl b;
+  b.par = {1.0, 1.0, 0.5, 1.0};
+  return b;
+}
+
+FlowState<Electron> electron_state(double h) {
+  FlowState<Electron> s;
+  for (int i = 0; i < 4; ++i) s.p[i] = Eigen::Vector3d(1.0 + 0.1 * i * h, 0.5 * i * h, -0.2 * i * h * i * h);
+  return s;
+}
+}  // namespace
+
+static void BM_BeanieControlStep_Engine(benchmark::State& st) {
+  const BeanieControl b = beanie();
+  const double h = 0.01;
+  const auto s = beanie_state(b, h);
+  const NewtonOptions opt;
+  StepUnknowns<BeanieControl> z;
+  for (auto _ : st) {
+    const StepReport r = solve_step(b, h, s, 2, opt, z);
+    benchmark::DoNotOptimize(r.iterations);
+    benchmark::DoNotOptimize(z);
+  }
+}
+BENCHMARK(BM_BeanieControlStep_Engine);
+
+static void BM_BeanieControlStep_Analytic(benchmark::State& st) {
+  const BeanieControl b = beanie();
+  const double h = 0.01;
+  const auto s = beanie_state(b, h);
+  for (auto _ : st) {
+    auto z = oracles::beanie_control_analytic_step(b, s, h);
+    benchmark::DoNotOptimize(z);
+  }
+}
+BENCHMARK(BM_BeanieControlStep_Analytic);
+
+static void BM_BeanieControlStep_EngineWithSensitivity(benchmark::State& st) {
+  const BeanieControl b = beanie();
+  const double h = 0.01;
+  const auto s = beanie_state(b, h);
+  const NewtonOptions opt;
+  StepUnknowns<BeanieControl> z;
+  for (auto _ : st) {
+    solve_step(b, h, s, 2, opt, z);
+    auto dz = step_sensitivity(b, h, s, z);
+    benchmark::DoNotOptimize(dz);
+  }
+}
+BENCHMARK(BM_BeanieControlStep_EngineWithSensitivity);
+
+static void BM_ElectronStep_Engine(benchmark::State& st) {
+  const Electron e;
+  const double h = 0.01;
+  const auto s = electron_state(h);
+  const NewtonOptions opt;
+  StepUnknowns<Electron> z;
+  for (auto _ : st) {
+    const StepReport r = solve_step(e, h, s, 2, opt, z);
+    benchmark::DoNotOptimize(r.iterations);
+    benchmark::DoNotOptimize(z);
+  }
+}
+BENCHMARK(BM_ElectronStep_Engine);
+
+static void BM_ElectronStep_Analytic(benchmark::State& st) {
+  const Electron e;
+  const double h = 0.01;
+  const auto s = electron_state(h);
+  for (auto _ : st) {
+    auto x = oracles::electron_analytic_step(e, {s.p[0], s.p[1], s.p[2], s.p[3]}, h);
+    benchmark::DoNotOptimize(x);
+  }
+}
+BENCHMARK(BM_ElectronStep_Analytic);
+
+BENCHMARK_MAIN();

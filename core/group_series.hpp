@@ -1,8 +1,8 @@
 // Smooth helper functions for the closed forms of SO(2) and SE(2) exp/log.
 //
 // sinc(w) = sin(w)/w and cosc(w) = (1 - cos(w))/w, evaluated by their Taylor series for
-// |w| < 0.5 (error below 1e-22, and exact derivatives of every order at w = 0, which the
-// engine hits at every Newton iterate) and by the closed form otherwise. cosc uses
+// |w| < 0.5 (error below 1e-17 in the value and first two derivatives, exact at w = 0, which
+// the engine hits at every Newton iterate) and by the closed form otherwise. cosc uses
 // 2 sin^2(w/2)/w, which has no cancellation.
 #pragma once
 
@@ -35,9 +35,13 @@ T alternating_series(const T& w, int shift) {
       series_coefficient(6, 1), series_coefficient(7, 1), series_coefficient(8, 1),
       series_coefficient(9, 1)};
   const double* c = shift == 0 ? c0 : c1;
+  // Terms kept so that the first omitted one, and its first two derivatives, are below 1e-17
+  // (the nested duals carry at most second derivatives): at w = 0 two terms are exact.
+  const double a = std::abs(value(w));
+  const int terms = a < 1e-8 ? 2 : a < 1e-3 ? 4 : a < 0.05 ? 6 : 10;
   const T w2 = w * w;
-  T acc = T(c[9]);
-  for (int j = 8; j >= 0; --j) acc = acc * w2 + c[j];
+  T acc = T(c[terms - 1]);
+  for (int j = terms - 2; j >= 0; --j) acc = acc * w2 + c[j];
   return acc;
 }
 

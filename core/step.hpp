@@ -62,46 +62,84 @@ struct NewtonOptions {
   double max_condition = 1e13;
 };
 
-// Evaluates F and its derivatives at (state, z). Derivative columns: the nz unknowns, then (if
-// with_state) the state's tangent coordinates.
-template <class P, int NO>
-void evaluate_step(const P& problem, double h, const FlowState<P>& s, const StepUnknowns<P>& z,
-                   bool with_state, Vec<double, Dims<P>::unknowns>& F,
-                   Eigen::Matrix<double, Dims<P>::unknowns, NO>& J) {
+// The step's node block (nodes n-k .. n+k) in scalar T. With T a Dual, the unknowns z are seeded
+// in derivative columns 0..nz-1 and, if seed_state, the state's tangent coordinates after them.
+template <class P, class T>
+NodeBlock<P, T> step_block(const FlowState<P>& s, const StepUnknowns<P>& z, bool seed_state) {
   using D = Dims<P>;
   using G = typename P::Group;
-  using T = Dual<double, NO>;
+  using FS = FlowState<P>;
   constexpr int k = D::k, nz = D::unknowns;
-  auto seeded = [](double x, int col) { return T::variable(x, col); };
-
+  auto var = [](double x, int col) {
+    if constexpr (std::is_same_v<T, double>) {
+      (void)col;
+      return x;
+    } else {
+      return T::variable(x, col);
+    }
+  };
   NodeBlock<P, T> b;
   for (int i = 0; i < 2 * k; ++i)
-    for (int a = 0; a < D::r; ++a)
-      b.p[i](a) = with_state ? seeded(s.p[i](a), nz + FlowState<P>::p_offset(i) + a) : T(s.p[i](a));
-  for (int a = 0; a < D::r; ++a) b.p[2 * k](a) = seeded(z.p(a), a);
+    for (int a = 0; a < D::r; ++a) b.p[i](a) = seed_state ? var(s.p[i](a), nz + FS::p_offset(i) + a) : T(s.p[i](a));
+  for (int a = 0; a < D::r; ++a) b.p[2 * k](a) = var(z.p(a), a);
   for (int i = 0; i < 2 * k - 1; ++i) {
     b.g[i] = G::template cast<T>(s.g[i]);
-    if (with_state) {
+    if (seed_state) {
       typename G::template Tangent<T> delta;
-      for (int a = 0; a < D::d; ++a) delta(a) = seeded(0.0, nz + FlowState<P>::g_offset(i) + a);
+      for (int a = 0; a < D::d; ++a) delta(a) = var(0.0, nz + FS::g_offset(i) + a);
       b.g[i] = G::compose(b.g[i], G::template exp<T>(delta));
     }
   }
-  typename G::template Tangent<T> zeta;
-  for (int a = 0; a < D::d; ++a) zeta(a) = seeded(0.0, D::r + a);
-  b.g[2 * k - 1] = G::compose(G::template cast<T>(z.g), G::template exp<T>(zeta));
+  b.g[2 * k - 1] = G::template cast<T>(z.g);
+  if constexpr (!std::is_same_v<T, double>) {  // g~_{n+k-1} = ĝ exp(ζ), ζ = 0 seeded
+    typename G::template Tangent<T> zeta;
+    for (int a = 0; a < D::d; ++a) zeta(a) = var(0.0, D::r + a);
+    b.g[2 * k - 1] = G::compose(b.g[2 * k - 1], G::template exp<T>(zeta));
+  }
   for (int j = 0; j < k; ++j)
     for (int a = 0; a < D::m; ++a)
-      b.lam[j](a) = with_state ? seeded(s.lam[j](a), nz + FlowState<P>::lam_offset(j) + a)
-                               : T(s.lam[j](a));
-  for (int a = 0; a < D::m; ++a) b.lam[k](a) = seeded(z.lam(a), D::r + D::d + a);
+      b.lam[j](a) = seed_state ? var(s.lam[j](a), nz + FS::lam_offset(j) + a) : T(s.lam[j](a));
+  for (int a = 0; a < D::m; ++a) b.lam[k](a) = var(z.lam(a), D::r + D::d + a);
+  return b;
+}
 
-  const Vec<T, D::node> E = node_residual(problem, b, k, 0, k, h);
+// The part of E_n that does not depend on z: windows a_{n-k} .. a_{n-1} (z = (p_{n+k}, g~_{n+k-1},
+// λ^n) enters window a_n only). Computed once per step.
+template <class P>
+Vec<double, Dims<P>::node> step_fixed_part(const P& problem, double h, const FlowState<P>& s,
+                                           const StepUnknowns<P>& z) {
+  const NodeBlock<P, double> b = step_block<P, double>(s, z, false);
+  return node_residual(problem, b, P::order, 0, P::order - 1, h);
+}
+
+// F = (E_n, chi_d(a_n)) at z, values only, given the fixed part of E_n.
+template <class P>
+Vec<double, Dims<P>::unknowns> step_residual(const P& problem, double h, const FlowState<P>& s,
+                                             const StepUnknowns<P>& z, const Vec<double, Dims<P>::node>& fixed) {
+  using D = Dims<P>;
+  const NodeBlock<P, double> b = step_block<P, double>(s, z, false);
+  Vec<double, D::unknowns> F;
+  F.template head<D::node>() = fixed + node_residual(problem, b, D::k, D::k, D::k, h);
+  if constexpr (D::m > 0) F.template tail<D::m>() = problem.template constraints<double>(b.window(D::k), h);
+  return F;
+}
+
+// F and its derivatives at (state, z). Derivative columns: the nz unknowns, then (if with_state)
+// the state's tangent coordinates. Given `fixed` (and no state derivatives), only window a_n is
+// differentiated.
+template <class P, int NO>
+void evaluate_step(const P& problem, double h, const FlowState<P>& s, const StepUnknowns<P>& z, bool with_state,
+                   const Vec<double, Dims<P>::node>* fixed, Vec<double, Dims<P>::unknowns>& F,
+                   Eigen::Matrix<double, Dims<P>::unknowns, NO>& J) {
+  using D = Dims<P>;
+  using T = Dual<double, NO>;
+  constexpr int k = D::k, nz = D::unknowns;
+  const NodeBlock<P, T> b = step_block<P, T>(s, z, with_state);
   Vec<T, nz> Fd;
-  Fd.template head<D::node>() = E;
+  Fd.template head<D::node>() = node_residual(problem, b, k, fixed ? k : 0, k, h);
   if constexpr (D::m > 0) Fd.template tail<D::m>() = problem.template constraints<T>(b.window(k), h);
   for (int i = 0; i < nz; ++i) {
-    F(i) = Fd(i).v;
+    F(i) = Fd(i).v + (fixed && i < D::node ? (*fixed)(i) : 0.0);
     for (int c = 0; c < NO; ++c) J(i, c) = Fd(i).d[c];
   }
 }
@@ -137,10 +175,12 @@ inline bool all_finite(const double* x, int n) {
 }
 
 // Solves step n by Newton from the predictor (linear extrapolation of p, previous increment and
-// multiplier). No allocation in the loop (everything is fixed size) except the failure message.
+// multiplier). The z-independent windows are evaluated once; after a Newton step, chord steps
+// (same factorization, residual only) are taken while they contract by 4x, else the Jacobian is
+// refreshed. No allocation in the loop (everything is fixed size) except the failure message.
 template <class P>
-StepReport solve_step(const P& problem, double h, const FlowState<P>& s, int n,
-                      const NewtonOptions& opt, StepUnknowns<P>& z) {
+StepReport solve_step(const P& problem, double h, const FlowState<P>& s, int n, const NewtonOptions& opt,
+                      StepUnknowns<P>& z) {
   using D = Dims<P>;
   constexpr int k = D::k, nz = D::unknowns;
   z.p = 2.0 * s.p[2 * k - 1] - s.p[2 * k - 2];
@@ -149,26 +189,37 @@ StepReport solve_step(const P& problem, double h, const FlowState<P>& s, int n,
 
   StepReport rep;
   rep.step = n;
-  Vec<double, nz> F;
-  Eigen::Matrix<double, nz, nz> J;
-  Eigen::PartialPivLU<Eigen::Matrix<double, nz, nz>> lu;
   auto fail = [&](StepStatus st, const std::string& why) {
     rep.status = st;
     rep.message = "step n=" + std::to_string(n) + ": " + why;
     return rep;
   };
+  const Vec<double, D::node> fixed = step_fixed_part(problem, h, s, z);
+  if (!all_finite(fixed.data(), D::node))
+    return fail(StepStatus::NonFinite, "the step equations evaluated to a non-finite number");
+  Vec<double, nz> F;
+  Eigen::Matrix<double, nz, nz> J;
+  Eigen::PartialPivLU<Eigen::Matrix<double, nz, nz>> lu;
+  bool refresh = true;
+  double last_step = std::numeric_limits<double>::infinity();
   for (int it = 1; it <= opt.max_iterations; ++it) {
-    evaluate_step<P, nz>(problem, h, s, z, false, F, J);
     rep.iterations = it;
-    if (!all_finite(F.data(), nz) || !all_finite(J.data(), nz * nz))
-      return fail(StepStatus::NonFinite, "the step equations evaluated to a non-finite number");
+    if (refresh) {
+      evaluate_step<P, nz>(problem, h, s, z, false, &fixed, F, J);
+      if (!all_finite(F.data(), nz) || !all_finite(J.data(), nz * nz))
+        return fail(StepStatus::NonFinite, "the step equations evaluated to a non-finite number");
+      lu.compute(J);
+      rep.condition = condition_number_1(J, lu);
+      if (!(rep.condition <= opt.max_condition))
+        return fail(StepStatus::Singular, "the step matrix (Proposition 2) is singular (condition " +
+                                              format_number(rep.condition) + " > " +
+                                              format_number(opt.max_condition) + ")");
+    } else {
+      F = step_residual(problem, h, s, z, fixed);
+      if (!all_finite(F.data(), nz))
+        return fail(StepStatus::NonFinite, "the step equations evaluated to a non-finite number");
+    }
     rep.residual = F.template lpNorm<Eigen::Infinity>();
-    lu.compute(J);
-    rep.condition = condition_number_1(J, lu);
-    if (!(rep.condition <= opt.max_condition))
-      return fail(StepStatus::Singular, "the step matrix (Proposition 2) is singular (condition " +
-                                            format_number(rep.condition) + " > " +
-                                            format_number(opt.max_condition) + ")");
     const Vec<double, nz> dz = lu.solve(-F);
     Vec<double, nz> scale;
     scale.template head<D::r>() = z.p.cwiseAbs();
@@ -179,6 +230,9 @@ StepReport solve_step(const P& problem, double h, const FlowState<P>& s, int n,
       rep.status = StepStatus::Converged;
       return rep;
     }
+    const double step = dz.template lpNorm<Eigen::Infinity>();
+    refresh = refresh ? false : !(step <= 0.25 * last_step);  // after a chord step that contracts too slowly
+    last_step = step;
   }
   return fail(StepStatus::NotConverged, "Newton did not converge in " + std::to_string(opt.max_iterations) +
                                             " iterations (residual " + format_number(rep.residual) + ")");
@@ -193,7 +247,7 @@ Eigen::Matrix<double, Dims<P>::unknowns, Dims<P>::state> step_sensitivity(const 
   constexpr int nz = D::unknowns, ns = D::state;
   Vec<double, nz> F;
   Eigen::Matrix<double, nz, nz + ns> J;
-  evaluate_step<P, nz + ns>(problem, h, s, z, true, F, J);
+  evaluate_step<P, nz + ns>(problem, h, s, z, true, nullptr, F, J);
   const Eigen::Matrix<double, nz, nz> Jz = J.template leftCols<nz>();
   const Eigen::Matrix<double, nz, ns> Js = J.template rightCols<ns>();
   return -Jz.partialPivLu().solve(Js);
