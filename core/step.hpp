@@ -13,6 +13,7 @@
 
 #include <cstdio>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 namespace lpshoot {
@@ -75,9 +76,13 @@ NodeBlock<P, T> step_block(const FlowState<P>& s, const StepUnknowns<P>& z, bool
       (void)col;
       return x;
     } else {
-      return T::variable(x, col);
+      return col < static_cast<int>(T().d.size()) ? T::variable(x, col) : T(x);
     }
   };
+  if constexpr (!std::is_same_v<T, double>) {
+    if (seed_state && static_cast<int>(T().d.size()) < nz + D::state)
+      throw std::logic_error("step_block: state seeds need nz + state derivative columns");
+  }
   NodeBlock<P, T> b;
   for (int i = 0; i < 2 * k; ++i)
     for (int a = 0; a < D::r; ++a) b.p[i](a) = seed_state ? var(s.p[i](a), nz + FS::p_offset(i) + a) : T(s.p[i](a));
@@ -162,10 +167,27 @@ inline std::string format_number(double x) {
 }
 
 // ||J||_1 ||J^{-1}||_1 from the LU factors (exact, cheap at these sizes); inf or NaN if singular.
+// J^{-1} e_j by plain substitutions: P J = L U, so J^{-1} e_j = U^{-1} L^{-1} P e_j.
 template <class M, class LU>
 double condition_number_1(const M& J, const LU& lu) {
-  const M inv = lu.inverse();
-  return J.cwiseAbs().colwise().sum().maxCoeff() * inv.cwiseAbs().colwise().sum().maxCoeff();
+  constexpr int n = M::RowsAtCompileTime;
+  const M& f = lu.matrixLU();
+  const auto perm = lu.permutationP().indices();
+  double inv_norm = 0;
+  for (int j = 0; j < n; ++j) {
+    double x[n > 0 ? n : 1];
+    for (int i = 0; i < n; ++i) x[i] = perm(j) == i ? 1.0 : 0.0;
+    for (int i = 0; i < n; ++i)
+      for (int c = 0; c < i; ++c) x[i] -= f(i, c) * x[c];
+    double col = 0;
+    for (int i = n - 1; i >= 0; --i) {
+      for (int c = i + 1; c < n; ++c) x[i] -= f(i, c) * x[c];
+      x[i] /= f(i, i);
+      col += std::abs(x[i]);
+    }
+    if (!(col <= inv_norm)) inv_norm = col;  // keeps a NaN from a zero pivot
+  }
+  return J.cwiseAbs().colwise().sum().maxCoeff() * inv_norm;
 }
 
 inline bool all_finite(const double* x, int n) {
