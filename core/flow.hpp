@@ -23,6 +23,14 @@ struct Trajectory {
   int N() const { return static_cast<int>(p.size()) - 1; }
   double time(int n) const { return n * h; }
 
+  // Window a_j = (p_j .. p_{j+k}, g~_j .. g~_{j+k-1}).
+  Window<P, double> window_at(int j) const {
+    Window<P, double> a;
+    for (int i = 0; i <= P::order; ++i) a.p[i] = p[j + i];
+    for (int i = 0; i < P::order; ++i) a.g[i] = g[j + i];
+    return a;
+  }
+
   // The flow state before step n (nodes n-k .. n+k-1).
   FlowState<P> state(int n) const {
     constexpr int k = P::order;
@@ -53,9 +61,41 @@ template <class P>
 struct FlowResult {
   Trajectory<P> trajectory;  // up to the last completed step
   FlowReport report;
-  // d(final state)/d(initial directions), Dims<P>::state x q, when a seed was given.
+  // d(final state)/d(initial directions), Dims<P>::state x q, when a seed was given; with a
+  // seed of Dims<P>::state + d rows, the last d rows are the group element at the state's first
+  // node (right tangent coordinates), starting from g0.
   Eigen::MatrixXd sensitivity;
+  // g at the first node of the final state (node N-2k+1), reconstructed from g0.
+  GroupElement<P, double> g_first;
 };
+
+// W_0 = g~_0 A(p_0, p_1)^{-1} of a state (g_{n+1} = g_n W_n) and its Jacobian: right tangent of W
+// with respect to (δp_0, δp_1, δ of g~_0) (d x (2r + d)).
+template <class P>
+GroupElement<P, double> first_increment(const P& problem, const FlowState<P>& s,
+                                        Eigen::Matrix<double, P::Group::dim, 2 * P::shape_dim + P::Group::dim>* jac) {
+  using G = typename P::Group;
+  constexpr int r = P::shape_dim, d = G::dim, nv = 2 * r + d;
+  auto W = [&](const auto& p0, const auto& p1, const auto& g) {
+    return G::compose(g, G::inverse(connection(problem, p0, p1)));
+  };
+  const GroupElement<P, double> W0 = W(s.p[0], s.p[1], s.g[0]);
+  if (jac) {
+    using T = Dual<double, nv>;
+    Vec<T, r> p0, p1;
+    typename G::template Tangent<T> delta;
+    for (int a = 0; a < r; ++a) {
+      p0(a) = T::variable(s.p[0](a), a);
+      p1(a) = T::variable(s.p[1](a), r + a);
+    }
+    for (int a = 0; a < d; ++a) delta(a) = T::variable(0.0, 2 * r + a);
+    const auto g = G::compose(G::template cast<T>(s.g[0]), G::template exp<T>(delta));
+    const auto diff = G::log(G::compose(G::template cast<T>(G::inverse(W0)), W(p0, p1, g)));
+    for (int i = 0; i < d; ++i)
+      for (int c = 0; c < nv; ++c) (*jac)(i, c) = diff(i).d[c];
+  }
+  return W0;
+}
 
 template <class P>
 class DiscreteFlow {
@@ -69,7 +109,9 @@ class DiscreteFlow {
 
   // Runs to node N (steps n = k .. N-k). `seed` (state x q, optional) gives the initial
   // directions whose sensitivity is propagated to the final state.
-  FlowResult<P> run(const FlowState<P>& initial, int N, const Eigen::MatrixXd* seed = nullptr) const {
+  FlowResult<P> run(const FlowState<P>& initial, int N, const Eigen::MatrixXd* seed = nullptr,
+                    const GroupElement<P, double>& g0 = P::Group::template identity<double>()) const {
+    using G = typename P::Group;
     constexpr int k = D::k, r = D::r, d = D::d, m = D::m, ns = D::state;
     FlowResult<P> out;
     Trajectory<P>& tr = out.trajectory;
@@ -81,12 +123,14 @@ class DiscreteFlow {
                     " (got h = " + format_number(h_) + ", N = " + std::to_string(N) + ")";
       return out;
     }
-    if (seed && seed->rows() != ns) {
+    if (seed && seed->rows() != ns && seed->rows() != ns + d) {
       rep.status = FlowStatus::InvalidInput;
       rep.message = "sensitivity seed has " + std::to_string(seed->rows()) + " rows, expected " +
-                    std::to_string(ns);
+                    std::to_string(ns) + " or " + std::to_string(ns + d);
       return out;
     }
+    const bool with_group = seed && seed->rows() == ns + d;
+    out.g_first = g0;
     tr.p.assign(initial.p.begin(), initial.p.end());
     tr.g.assign(initial.g.begin(), initial.g.end());
     tr.lam.assign(initial.lam.begin(), initial.lam.end());
@@ -119,7 +163,7 @@ class DiscreteFlow {
         const Eigen::Matrix<double, D::unknowns, ns> dz = step_sensitivity(problem_, h_, s, z);
         const Eigen::MatrixXd dzS = dz * out.sensitivity;
         const Eigen::MatrixXd& S = out.sensitivity;
-        next.resize(ns, S.cols());
+        next.resize(S.rows(), S.cols());
         using FS = FlowState<P>;
         next.middleRows(FS::p_offset(0), (2 * k - 1) * r) = S.middleRows(FS::p_offset(1), (2 * k - 1) * r);
         next.middleRows(FS::p_offset(2 * k - 1), r) = dzS.topRows(r);
@@ -127,8 +171,16 @@ class DiscreteFlow {
         next.middleRows(FS::g_offset(2 * k - 2), d) = dzS.middleRows(r, d);
         next.middleRows(FS::lam_offset(0), (k - 1) * m) = S.middleRows(FS::lam_offset(1), (k - 1) * m);
         next.middleRows(FS::lam_offset(k - 1), m) = dzS.bottomRows(m);
+        if (with_group) {  // g_{first+1} = g_first W_first: δ' = Ad_{W^{-1}} δ + J_W δ(p_0, p_1, g~_0)
+          Eigen::Matrix<double, d, 2 * r + d> JW;
+          const auto W = first_increment(problem_, s, &JW);
+          Eigen::MatrixXd old(2 * r + d, S.cols());
+          old << S.middleRows(FS::p_offset(0), 2 * r), S.middleRows(FS::g_offset(0), d);
+          next.bottomRows(d) = G::Ad(G::inverse(W)) * S.bottomRows(d) + JW * old;
+        }
         out.sensitivity.swap(next);
       }
+      out.g_first = G::compose(out.g_first, first_increment<P>(problem_, s, nullptr));
       // Shift the state and store the new unknowns.
       for (int i = 0; i + 1 < 2 * k; ++i) s.p[i] = s.p[i + 1];
       s.p[2 * k - 1] = z.p;

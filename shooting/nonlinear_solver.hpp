@@ -1,0 +1,45 @@
+// A square nonlinear system F(x) = 0 with an exact Jacobian, and the solver backends behind one
+// interface: SUNDIALS KINSOL (Newton with line search, fresh Jacobian every iteration) and NLopt
+// (SLSQP with the equations as equality constraints). The C libraries stay in the .cpp files.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+namespace lpshoot {
+
+class NonlinearSystem {
+ public:
+  virtual ~NonlinearSystem() = default;
+  virtual int size() const = 0;
+  // Returns false when F cannot be evaluated at x (the flow failed): solvers then shorten the step.
+  virtual bool residual(const Eigen::VectorXd& x, Eigen::VectorXd& F) = 0;
+  virtual bool jacobian(const Eigen::VectorXd& x, Eigen::MatrixXd& J) = 0;
+};
+
+enum class Backend { Kinsol, Nlopt };
+
+struct SolverOptions {
+  Backend backend = Backend::Kinsol;
+  double tolerance = 1e-10;  // max-norm of F at a solution
+  int max_iterations = 50;
+};
+
+enum class SolverStatus { Converged, NotConverged, Failed };
+
+struct SolverOutcome {
+  SolverStatus status = SolverStatus::NotConverged;
+  std::string message;
+  int iterations = 0;
+  std::vector<double> residual_history;  // max-norm of F at each accepted iterate
+  double residual_norm = 0;
+};
+
+// Solves F(x) = 0 from x (updated in place).
+SolverOutcome solve_nonlinear(NonlinearSystem& system, Eigen::VectorXd& x, const SolverOptions& options);
+
+const char* backend_name(Backend b);
+
+}  // namespace lpshoot

@@ -1,0 +1,410 @@
+// Single and multiple shooting for discrete boundary value problems (METHOD.md §5).
+//
+// Unknowns: the extended state (flow state + absolute group element at its first node) at the
+// start of each segment, in tangent coordinates around a reference (g = g_ref exp(x)). Residuals:
+// initial constraints and conditions on the first segment's start, continuity defects (group parts
+// in the tangent space) between segments, terminal conditions on the last segment's end. The
+// Jacobian is exact: flow sensitivities (implicit function theorem) times automatic derivatives
+// of the conditions; for multiple shooting it is block bidiagonal and the segments are propagated
+// in parallel.
+#pragma once
+
+#include "boundary.hpp"
+#include "nonlinear_solver.hpp"
+
+#include <Eigen/SVD>
+
+#include <chrono>
+#include <thread>
+
+namespace lpshoot {
+
+enum class ShootingMethod { Single, Multiple };
+
+struct ShootingOptions {
+  ShootingMethod method = ShootingMethod::Single;
+  int segments = 4;  // multiple shooting
+  SolverOptions solver;
+  NewtonOptions step;
+  double rank_tolerance = 1e-9;  // singular values below this times the largest count as zero
+  int threads = 0;               // 0: one per available core
+};
+
+enum class ShootingStatus { Converged, NotConverged, RankDeficient, FlowFailed, InvalidProblem };
+
+template <class P>
+struct ShootingResult {
+  ShootingStatus status = ShootingStatus::NotConverged;
+  std::string message;
+  int iterations = 0;
+  std::vector<double> residual_history;
+  double residual_norm = 0;
+  double condition = 0;  // of the shooting Jacobian at the solution (2-norm)
+  int rank = 0, unknowns = 0;
+  std::vector<std::string> dependent_conditions;  // when rank deficient
+  double wall_time_s = 0;
+  Trajectory<P> trajectory;
+  std::vector<GroupElement<P, double>> g;  // reconstructed g_0 .. g_N
+  double cost = 0;                         // Σ L_d(a_n)
+  double momentum_drift = 0;               // relative max |J_n - J_{k-1}|
+  bool ok() const { return status == ShootingStatus::Converged; }
+};
+
+const char* status_name(ShootingStatus s);
+
+namespace detail {
+
+// Block of scalar T from an extended boundary state seeded in all its tangent directions.
+template <class P, class T>
+NodeBlock<P, T> seeded_block(const BoundaryState<P>& x, GroupElement<P, T>& g_first) {
+  using G = typename P::Group;
+  using FS = FlowState<P>;
+  constexpr int k = P::order, r = P::shape_dim, d = G::dim, m = P::num_constraints, ns = Dims<P>::state;
+  NodeBlock<P, T> b;
+  for (int i = 0; i < 2 * k; ++i)
+    for (int a = 0; a < r; ++a) b.p[i](a) = T::variable(x.s.p[i](a), FS::p_offset(i) + a);
+  for (int i = 0; i < 2 * k - 1; ++i) {
+    typename G::template Tangent<T> delta;
+    for (int a = 0; a < d; ++a) delta(a) = T::variable(0.0, FS::g_offset(i) + a);
+    b.g[i] = G::compose(G::template cast<T>(x.s.g[i]), G::template exp<T>(delta));
+  }
+  for (int j = 0; j < k; ++j)
+    for (int a = 0; a < m; ++a) b.lam[j](a) = T::variable(x.s.lam[j](a), FS::lam_offset(j) + a);
+  b.p[2 * k] = b.p[2 * k - 1];
+  b.g[2 * k - 1] = b.g[2 * k - 2];
+  b.lam[k] = b.lam[k - 1];
+  typename G::template Tangent<T> delta;
+  for (int a = 0; a < d; ++a) delta(a) = T::variable(0.0, ns + a);
+  g_first = G::compose(G::template cast<T>(x.g), G::template exp<T>(delta));
+  return b;
+}
+
+// Values and Jacobian (rows x BoundaryState::size) of one end's conditions.
+template <class P>
+void boundary_block(const BoundaryValueProblem<P>& bvp, End e, const BoundaryState<P>& x, Eigen::VectorXd& R,
+                    Eigen::MatrixXd* J) {
+  constexpr int n = BoundaryState<P>::size;
+  using T = Dual<double, n>;
+  GroupElement<P, T> g;
+  const NodeBlock<P, T> b = seeded_block<P, T>(x, g);
+  const std::vector<T> res = boundary_residuals(bvp, e, b, g);
+  R.resize(res.size());
+  if (J) J->resize(res.size(), n);
+  for (size_t i = 0; i < res.size(); ++i) {
+    R(i) = res[i].v;
+    if (J)
+      for (int c = 0; c < n; ++c) (*J)(i, c) = res[i].d[c];
+  }
+}
+
+// x = x_ref ⊕ δ on an extended state, and the right Jacobian of the retraction for each group
+// block (so that d/dδ = d/d(tangent at x) · Jr).
+template <class P>
+BoundaryState<P> retract_extended(const BoundaryState<P>& ref, const Eigen::VectorXd& delta,
+                                  Eigen::MatrixXd* Jr = nullptr) {
+  using G = typename P::Group;
+  using FS = FlowState<P>;
+  constexpr int k = P::order, d = G::dim, ns = Dims<P>::state, n = BoundaryState<P>::size;
+  BoundaryState<P> x;
+  x.s = retract(ref.s, Vec<double, ns>(delta.head<ns>()));
+  const typename G::template Tangent<double> dg = delta.segment<d>(ns);
+  x.g = G::compose(ref.g, G::template exp<double>(dg));
+  if (Jr) {
+    Jr->setIdentity(n, n);
+    auto block = [&](int off) {  // Jr(ξ) = d/dε log(exp(ξ)^{-1} exp(ξ + ε))
+      using T = Dual<double, d>;
+      typename G::template Tangent<T> xi;
+      for (int a = 0; a < d; ++a) xi(a) = T::variable(delta(off + a), a);
+      const auto e = G::log(G::compose(G::template cast<T>(G::inverse(G::template exp<double>(
+                                           typename G::template Tangent<double>(delta.segment<d>(off))))),
+                                       G::template exp<T>(xi)));
+      for (int i = 0; i < d; ++i)
+        for (int c = 0; c < d; ++c) (*Jr)(off + i, off + c) = e(i).d[c];
+    };
+    for (int i = 0; i < 2 * k - 1; ++i) block(FS::g_offset(i));
+    block(ns);
+  }
+  return x;
+}
+
+template <class P>
+Eigen::VectorXd extended_difference(const BoundaryState<P>& a, const BoundaryState<P>& b) {
+  using G = typename P::Group;
+  constexpr int ns = Dims<P>::state, n = BoundaryState<P>::size;
+  Eigen::VectorXd v(n);
+  v.head<ns>() = state_difference(a.s, b.s);
+  v.tail<G::dim>() = G::log(G::compose(G::inverse(b.g), a.g));
+  return v;
+}
+
+// The shooting equations for S >= 1 segments between state indices s_0 = k < s_1 < ... < s_S = N-k+1.
+template <class P>
+class ShootingSystem : public NonlinearSystem {
+ public:
+  static constexpr int n = BoundaryState<P>::size;
+  ShootingSystem(const BoundaryValueProblem<P>& bvp, std::vector<BoundaryState<P>> refs, std::vector<int> starts,
+                 const NewtonOptions& step, int threads)
+      : bvp_(bvp), refs_(std::move(refs)), starts_(std::move(starts)), flow_(bvp.problem, bvp.h(), step),
+        threads_(threads) {}
+
+  int size() const override { return n * static_cast<int>(refs_.size()); }
+  int segments() const { return static_cast<int>(refs_.size()); }
+
+  bool residual(const Eigen::VectorXd& x, Eigen::VectorXd& F) override { return evaluate(x, F, nullptr); }
+  bool jacobian(const Eigen::VectorXd& x, Eigen::MatrixXd& J) override {
+    Eigen::VectorXd F;
+    return evaluate(x, F, &J);
+  }
+
+  // Runs all segments at x; fills the per-segment results. False if a flow failed.
+  bool propagate(const Eigen::VectorXd& x, bool sensitivities, std::vector<FlowResult<P>>& runs,
+                 std::vector<BoundaryState<P>>& starts, std::vector<Eigen::MatrixXd>& Jr) {
+    const int S = segments();
+    runs.resize(S);
+    starts.resize(S);
+    Jr.resize(S);
+    for (int i = 0; i < S; ++i)
+      starts[i] = retract_extended(refs_[i], x.segment(i * n, n), sensitivities ? &Jr[i] : nullptr);
+    auto work = [&](int i) {
+      const int N_local = starts_[i + 1] - starts_[i] + 2 * P::order - 1;
+      const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(n, n);
+      runs[i] = flow_.run(starts[i].s, N_local, sensitivities ? &I : nullptr, starts[i].g);
+    };
+    const int T = std::max(1, std::min(S, threads_ > 0 ? threads_ : static_cast<int>(std::thread::hardware_concurrency())));
+    if (T == 1) {
+      for (int i = 0; i < S; ++i) work(i);
+    } else {
+      std::vector<std::thread> pool;
+      for (int t = 0; t < T; ++t)
+        pool.emplace_back([&, t] {
+          for (int i = t; i < S; i += T) work(i);
+        });
+      for (auto& th : pool) th.join();
+    }
+    last_failure_.clear();
+    for (int i = 0; i < S; ++i)
+      if (!runs[i].report.ok()) {
+        last_failure_ = "segment " + std::to_string(i) + ": " + runs[i].report.message;
+        return false;
+      }
+    return true;
+  }
+
+  const std::string& last_failure() const { return last_failure_; }
+  const std::vector<int>& starts() const { return starts_; }
+  const BoundaryValueProblem<P>& bvp() const { return bvp_; }
+  std::vector<std::string> row_names() const {
+    std::vector<std::string> names;
+    for (int j = 0; j < P::order * P::num_constraints; ++j) names.push_back("initial constraint " + std::to_string(j));
+    for (const auto& c : bvp_.conditions)
+      if (c.end == End::Initial) names.push_back(c.name);
+    for (int i = 0; i + 1 < segments(); ++i)
+      for (int a = 0; a < n; ++a) names.push_back("continuity " + std::to_string(i) + "." + std::to_string(a));
+    for (const auto& c : bvp_.conditions)
+      if (c.end == End::Terminal) names.push_back(c.name);
+    return names;
+  }
+  BoundaryState<P> end_state(const FlowResult<P>& run) const {
+    const int N_local = run.trajectory.N();
+    return {run.trajectory.state(N_local - P::order + 1), run.g_first};
+  }
+
+ private:
+  bool evaluate(const Eigen::VectorXd& x, Eigen::VectorXd& F, Eigen::MatrixXd* J) {
+    std::vector<FlowResult<P>> runs;
+    std::vector<BoundaryState<P>> starts;
+    std::vector<Eigen::MatrixXd> Jr;
+    if (!propagate(x, J != nullptr, runs, starts, Jr)) return false;
+    const int S = segments(), N = size();
+    F.resize(N);
+    if (J) J->setZero(N, N);
+    int row = 0;
+    Eigen::VectorXd R;
+    Eigen::MatrixXd JB;
+    boundary_block(bvp_, End::Initial, starts[0], R, J ? &JB : nullptr);
+    F.segment(row, R.size()) = R;
+    if (J) J->block(row, 0, R.size(), n) = JB * Jr[0];
+    row += R.size();
+    for (int i = 0; i + 1 < S; ++i) {  // continuity: end of segment i minus start of segment i+1
+      const BoundaryState<P> e = end_state(runs[i]);
+      F.segment(row, n) = extended_difference(e, starts[i + 1]);
+      if (J) {
+        // d/d(end) of log(start^{-1} end) ≈ I and d/d(start) ≈ -I at the solution; exact forms:
+        Eigen::MatrixXd De, Ds;
+        difference_jacobians(e, starts[i + 1], De, Ds);
+        J->block(row, i * n, n, n) = De * runs[i].sensitivity * Jr[i];
+        J->block(row, (i + 1) * n, n, n) = Ds * Jr[i + 1];
+      }
+      row += n;
+    }
+    const BoundaryState<P> e = end_state(runs[S - 1]);
+    boundary_block(bvp_, End::Terminal, e, R, J ? &JB : nullptr);
+    F.segment(row, R.size()) = R;
+    if (J) J->block(row, (S - 1) * n, R.size(), n) = JB * runs[S - 1].sensitivity * Jr[S - 1];
+    row += R.size();
+    return row == N;
+  }
+
+  // Jacobians of extended_difference(a, b) with respect to right perturbations of a and of b.
+  static void difference_jacobians(const BoundaryState<P>& a, const BoundaryState<P>& b, Eigen::MatrixXd& Da,
+                                   Eigen::MatrixXd& Db) {
+    using T = Dual<double, 2 * n>;
+    using G = typename P::Group;
+    constexpr int ns = Dims<P>::state;
+    auto lift = [](const BoundaryState<P>& x, int off, NodeBlock<P, T>& blk, GroupElement<P, T>& g) {
+      using FS = FlowState<P>;
+      constexpr int k = P::order;
+      for (int i = 0; i < 2 * k; ++i)
+        for (int c = 0; c < P::shape_dim; ++c) blk.p[i](c) = T::variable(x.s.p[i](c), off + FS::p_offset(i) + c);
+      for (int i = 0; i < 2 * k - 1; ++i) {
+        typename G::template Tangent<T> dl;
+        for (int c = 0; c < G::dim; ++c) dl(c) = T::variable(0.0, off + FS::g_offset(i) + c);
+        blk.g[i] = G::compose(G::template cast<T>(x.s.g[i]), G::template exp<T>(dl));
+      }
+      for (int j = 0; j < k; ++j)
+        for (int c = 0; c < P::num_constraints; ++c) blk.lam[j](c) = T::variable(x.s.lam[j](c), off + FS::lam_offset(j) + c);
+      typename G::template Tangent<T> dl;
+      for (int c = 0; c < G::dim; ++c) dl(c) = T::variable(0.0, off + ns + c);
+      g = G::compose(G::template cast<T>(x.g), G::template exp<T>(dl));
+    };
+    NodeBlock<P, T> ba, bb;
+    GroupElement<P, T> ga, gb;
+    lift(a, 0, ba, ga);
+    lift(b, n, bb, gb);
+    std::vector<T> v;
+    constexpr int k = P::order;
+    for (int i = 0; i < 2 * k; ++i)
+      for (int c = 0; c < P::shape_dim; ++c) v.push_back(ba.p[i](c) - bb.p[i](c));
+    for (int i = 0; i < 2 * k - 1; ++i) {
+      const auto l = G::log(G::compose(G::inverse(bb.g[i]), ba.g[i]));
+      for (int c = 0; c < G::dim; ++c) v.push_back(l(c));
+    }
+    for (int j = 0; j < k; ++j)
+      for (int c = 0; c < P::num_constraints; ++c) v.push_back(ba.lam[j](c) - bb.lam[j](c));
+    const auto l = G::log(G::compose(G::inverse(gb), ga));
+    for (int c = 0; c < G::dim; ++c) v.push_back(l(c));
+    Da.resize(n, n);
+    Db.resize(n, n);
+    for (int i = 0; i < n; ++i)
+      for (int c = 0; c < n; ++c) {
+        Da(i, c) = v[i].d[c];
+        Db(i, c) = v[i].d[n + c];
+      }
+  }
+
+  BoundaryValueProblem<P> bvp_;
+  std::vector<BoundaryState<P>> refs_;
+  std::vector<int> starts_;
+  DiscreteFlow<P> flow_;
+  int threads_;
+  std::string last_failure_;
+};
+
+}  // namespace detail
+
+// An initial guess: a full discrete trajectory (p_0..p_N, g~_0..g~_{N-1}, λ^0..λ^{N-k}) and g_0.
+template <class P>
+struct ShootingGuess {
+  Trajectory<P> trajectory;
+  GroupElement<P, double> g0 = P::Group::template identity<double>();
+};
+
+// Solves the boundary value problem from a guess (e.g. interpolation of the boundary data, a
+// previous solution resampled to this grid).
+template <class P>
+ShootingResult<P> solve_bvp(const BoundaryValueProblem<P>& bvp, const ShootingGuess<P>& guess,
+                            const ShootingOptions& opt = {}) {
+  using G = typename P::Group;
+  constexpr int k = P::order, n = BoundaryState<P>::size;
+  const auto t0 = std::chrono::steady_clock::now();
+  ShootingResult<P> out;
+  auto finish = [&](ShootingStatus st, std::string msg) {
+    out.status = st;
+    out.message = std::move(msg);
+    out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return out;
+  };
+  if (const std::string why = check_counting(bvp); !why.empty()) return finish(ShootingStatus::InvalidProblem, why);
+  if (guess.trajectory.N() != bvp.N || static_cast<int>(guess.trajectory.lam.size()) != bvp.N - k + 1)
+    return finish(ShootingStatus::InvalidProblem, "the initial guess has N = " + std::to_string(guess.trajectory.N()) +
+                                                      ", the problem N = " + std::to_string(bvp.N));
+  // Segment starts (state indices) and reference states from the guess.
+  const int first = k, last = bvp.N - k + 1;
+  const int S = opt.method == ShootingMethod::Single ? 1 : std::max(1, std::min(opt.segments, last - first));
+  std::vector<int> starts;
+  for (int i = 0; i <= S; ++i) starts.push_back(first + static_cast<int>(std::lround(double(last - first) * i / S)));
+  const auto g = reconstruct_group(bvp.problem, guess.trajectory, guess.g0);
+  std::vector<BoundaryState<P>> refs;
+  for (int i = 0; i < S; ++i) refs.push_back({guess.trajectory.state(starts[i]), g[starts[i] - k]});
+  detail::ShootingSystem<P> system(bvp, refs, starts, opt.step, opt.threads);
+  out.unknowns = system.size();
+
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(system.size());
+  const SolverOutcome so = solve_nonlinear(system, x, opt.solver);
+  out.iterations = so.iterations;
+  out.residual_history = so.residual_history;
+  out.residual_norm = so.residual_norm;
+
+  // The trajectory at the final iterate.
+  std::vector<FlowResult<P>> runs;
+  std::vector<BoundaryState<P>> st;
+  std::vector<Eigen::MatrixXd> Jr;
+  if (!system.propagate(x, false, runs, st, Jr))
+    return finish(ShootingStatus::FlowFailed, "the discrete flow failed at the final iterate: " + system.last_failure());
+  Trajectory<P>& tr = out.trajectory;
+  tr = runs[0].trajectory;
+  for (int i = 1; i < S; ++i) {  // append the nodes each later segment adds
+    const Trajectory<P>& t = runs[i].trajectory;
+    const int skip_p = 2 * k, skip_g = 2 * k - 1, skip_l = k;
+    tr.p.insert(tr.p.end(), t.p.begin() + skip_p, t.p.end());
+    tr.g.insert(tr.g.end(), t.g.begin() + skip_g, t.g.end());
+    tr.lam.insert(tr.lam.end(), t.lam.begin() + skip_l, t.lam.end());
+  }
+  out.g = reconstruct_group(bvp.problem, tr, st[0].g);
+  for (int j = 0; j + k <= tr.N(); ++j) out.cost += bvp.problem.lagrangian(tr.window_at(j), tr.h);
+  if constexpr (G::dim > 0) out.momentum_drift = momentum_drift(bvp.problem, tr, st[0].g);
+
+  // Conditioning and rank of the shooting Jacobian at the final iterate.
+  Eigen::MatrixXd J;
+  if (system.jacobian(x, J)) {
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeFullU);
+    const auto& sv = svd.singularValues();
+    out.condition = sv(sv.size() - 1) > 0 ? sv(0) / sv(sv.size() - 1) : INFINITY;
+    out.rank = 0;
+    for (int i = 0; i < sv.size(); ++i)
+      if (sv(i) > opt.rank_tolerance * sv(0)) ++out.rank;
+    if (out.rank < out.unknowns) {
+      const auto names = system.row_names();
+      for (int c = out.rank; c < sv.size(); ++c) {  // left null vectors: dependent conditions
+        const Eigen::VectorXd u = svd.matrixU().col(c);
+        std::string dep;
+        for (int i = 0; i < u.size(); ++i)
+          if (std::abs(u(i)) > 0.1) dep += (dep.empty() ? "" : " + ") + std::to_string(u(i)).substr(0, 6) + "·[" + names[i] + "]";
+        out.dependent_conditions.push_back(dep);
+      }
+    }
+  }
+  if (out.rank < out.unknowns) {
+    std::string msg = "the shooting Jacobian is rank deficient (rank " + std::to_string(out.rank) + " of " +
+                      std::to_string(out.unknowns) + "): the boundary data are redundant or inconsistent; dependent: ";
+    for (size_t i = 0; i < out.dependent_conditions.size(); ++i) msg += (i ? "; " : "") + out.dependent_conditions[i];
+    if (so.status != SolverStatus::Converged) msg += " (" + so.message + ")";
+    return finish(ShootingStatus::RankDeficient, msg);
+  }
+  if (so.status != SolverStatus::Converged)
+    return finish(ShootingStatus::NotConverged, so.message.empty() ? "the solver did not converge" : so.message);
+  return finish(ShootingStatus::Converged, "");
+}
+
+inline const char* status_name(ShootingStatus s) {
+  switch (s) {
+    case ShootingStatus::Converged: return "converged";
+    case ShootingStatus::NotConverged: return "not_converged";
+    case ShootingStatus::RankDeficient: return "rank_deficient";
+    case ShootingStatus::FlowFailed: return "flow_failed";
+    case ShootingStatus::InvalidProblem: return "invalid_problem";
+  }
+  return "unknown";
+}
+
+}  // namespace lpshoot
