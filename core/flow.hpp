@@ -171,12 +171,14 @@ class DiscreteFlow {
         next.middleRows(FS::g_offset(2 * k - 2), d) = dzS.middleRows(r, d);
         next.middleRows(FS::lam_offset(0), (k - 1) * m) = S.middleRows(FS::lam_offset(1), (k - 1) * m);
         next.middleRows(FS::lam_offset(k - 1), m) = dzS.bottomRows(m);
-        if (with_group) {  // g_{first+1} = g_first W_first: δ' = Ad_{W^{-1}} δ + J_W δ(p_0, p_1, g~_0)
-          Eigen::Matrix<double, d, 2 * r + d> JW;
-          const auto W = first_increment(problem_, s, &JW);
-          Eigen::MatrixXd old(2 * r + d, S.cols());
-          old << S.middleRows(FS::p_offset(0), 2 * r), S.middleRows(FS::g_offset(0), d);
-          next.bottomRows(d) = G::Ad(G::inverse(W)) * S.bottomRows(d) + JW * old;
+        if constexpr (d > 0) {
+          if (with_group) {  // g_{first+1} = g_first W_first: δ' = Ad_{W^{-1}} δ + J_W δ(p_0, p_1, g~_0)
+            Eigen::Matrix<double, d, 2 * r + d> JW;
+            const auto W = first_increment(problem_, s, &JW);
+            Eigen::MatrixXd old(2 * r + d, S.cols());
+            old << S.middleRows(FS::p_offset(0), 2 * r), S.middleRows(FS::g_offset(0), d);
+            next.bottomRows(d) = G::Ad(G::inverse(W)) * S.bottomRows(d) + JW * old;
+          }
         }
         out.sensitivity.swap(next);
       }

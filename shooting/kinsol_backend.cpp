@@ -123,7 +123,7 @@ SolverOutcome solve_kinsol(NonlinearSystem& system, Eigen::VectorXd& x, const So
   } else {
     out.status = flag < 0 ? SolverStatus::Failed : SolverStatus::NotConverged;
     out.message = "KINSOL stopped with " + flag_name + " after " + std::to_string(out.iterations) +
-                  " iterations, residual " + std::to_string(out.residual_norm);
+                  " iterations, residual " + format_residual(out.residual_norm);
   }
   return out;
 }

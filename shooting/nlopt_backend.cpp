@@ -6,6 +6,7 @@
 #include <nlopt.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <exception>
 
 namespace lpshoot {
@@ -85,7 +86,7 @@ SolverOutcome solve_nlopt(NonlinearSystem& system, Eigen::VectorXd& x, const Sol
   } else {
     out.status = SolverStatus::NotConverged;
     out.message = why + " after " + std::to_string(out.iterations) + " evaluations, residual " +
-                  std::to_string(out.residual_norm);
+                  format_residual(out.residual_norm);
   }
   return out;
 }
@@ -94,6 +95,12 @@ SolverOutcome solve_kinsol(NonlinearSystem& system, Eigen::VectorXd& x, const So
 
 SolverOutcome solve_nonlinear(NonlinearSystem& system, Eigen::VectorXd& x, const SolverOptions& opt) {
   return opt.backend == Backend::Kinsol ? solve_kinsol(system, x, opt) : solve_nlopt(system, x, opt);
+}
+
+std::string format_residual(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", x);
+  return buf;
 }
 
 const char* backend_name(Backend b) { return b == Backend::Kinsol ? "kinsol" : "nlopt"; }

@@ -42,4 +42,7 @@ SolverOutcome solve_nonlinear(NonlinearSystem& system, Eigen::VectorXd& x, const
 
 const char* backend_name(Backend b);
 
+// "1.23e-09"
+std::string format_residual(double x);
+
 }  // namespace lpshoot

@@ -26,7 +26,7 @@ struct ShootingOptions {
   int segments = 4;  // multiple shooting
   SolverOptions solver;
   NewtonOptions step;
-  double rank_tolerance = 1e-9;  // singular values below this times the largest count as zero
+  double rank_tolerance = 1e-12;  // singular values of the equilibrated Jacobian below this times the largest count as zero
   int threads = 0;               // 0: one per available core
 };
 
@@ -39,9 +39,12 @@ struct ShootingResult {
   int iterations = 0;
   std::vector<double> residual_history;
   double residual_norm = 0;
-  double condition = 0;  // of the shooting Jacobian at the solution (2-norm)
+  double condition = 0;  // 2-norm condition of the equilibrated shooting Jacobian at the solution
+  // residual_norm is the max-norm of the residual with rows scaled by 1/|row of the Jacobian at
+  // the guess|: in units of the unknowns.
   int rank = 0, unknowns = 0;
   std::vector<std::string> dependent_conditions;  // when rank deficient
+  std::vector<double> singular_values;            // of the equilibrated Jacobian, descending
   double wall_time_s = 0;
   Trajectory<P> trajectory;
   std::vector<GroupElement<P, double>> g;  // reconstructed g_0 .. g_N
@@ -150,11 +153,20 @@ class ShootingSystem : public NonlinearSystem {
   int size() const override { return n * static_cast<int>(refs_.size()); }
   int segments() const { return static_cast<int>(refs_.size()); }
 
-  bool residual(const Eigen::VectorXd& x, Eigen::VectorXd& F) override { return evaluate(x, F, nullptr); }
+  // Residual rows are scaled by w (set from the row norms of the Jacobian at the guess), so
+  // that each scaled residual measures how far the unknowns are from satisfying its condition.
+  bool residual(const Eigen::VectorXd& x, Eigen::VectorXd& F) override {
+    if (!evaluate(x, F, nullptr)) return false;
+    if (w_.size() == F.size()) F.array() *= w_.array();
+    return true;
+  }
   bool jacobian(const Eigen::VectorXd& x, Eigen::MatrixXd& J) override {
     Eigen::VectorXd F;
-    return evaluate(x, F, &J);
+    if (!evaluate(x, F, &J)) return false;
+    if (w_.size() == J.rows()) J = w_.asDiagonal() * J;
+    return true;
   }
+  void set_row_scaling(const Eigen::VectorXd& w) { w_ = w; }
 
   // Runs all segments at x; fills the per-segment results. False if a flow failed.
   bool propagate(const Eigen::VectorXd& x, bool sensitivities, std::vector<FlowResult<P>>& runs,
@@ -298,6 +310,7 @@ class ShootingSystem : public NonlinearSystem {
   DiscreteFlow<P> flow_;
   int threads_;
   std::string last_failure_;
+  Eigen::VectorXd w_;
 };
 
 }  // namespace detail
@@ -315,7 +328,7 @@ template <class P>
 ShootingResult<P> solve_bvp(const BoundaryValueProblem<P>& bvp, const ShootingGuess<P>& guess,
                             const ShootingOptions& opt = {}) {
   using G = typename P::Group;
-  constexpr int k = P::order, n = BoundaryState<P>::size;
+  constexpr int k = P::order;
   const auto t0 = std::chrono::steady_clock::now();
   ShootingResult<P> out;
   auto finish = [&](ShootingStatus st, std::string msg) {
@@ -340,6 +353,17 @@ ShootingResult<P> solve_bvp(const BoundaryValueProblem<P>& bvp, const ShootingGu
   out.unknowns = system.size();
 
   Eigen::VectorXd x = Eigen::VectorXd::Zero(system.size());
+  {  // Row scaling from the Jacobian at the guess.
+    Eigen::MatrixXd J0;
+    if (!system.jacobian(x, J0))
+      return finish(ShootingStatus::FlowFailed, "the discrete flow failed from the initial guess: " + system.last_failure());
+    Eigen::VectorXd w(J0.rows());
+    for (int i = 0; i < J0.rows(); ++i) {
+      const double norm = J0.row(i).lpNorm<Eigen::Infinity>();
+      w(i) = norm > 0 ? 1.0 / norm : 1.0;
+    }
+    system.set_row_scaling(w);
+  }
   const SolverOutcome so = solve_nonlinear(system, x, opt.solver);
   out.iterations = so.iterations;
   out.residual_history = so.residual_history;
@@ -366,9 +390,13 @@ ShootingResult<P> solve_bvp(const BoundaryValueProblem<P>& bvp, const ShootingGu
 
   // Conditioning and rank of the shooting Jacobian at the final iterate.
   Eigen::MatrixXd J;
-  if (system.jacobian(x, J)) {
+  if (system.jacobian(x, J)) {  // rows already scaled; scale the columns too for the rank decision
+    Eigen::VectorXd cs(J.cols());
+    for (int c = 0; c < J.cols(); ++c) cs(c) = J.col(c).lpNorm<Eigen::Infinity>() > 0 ? 1.0 / J.col(c).lpNorm<Eigen::Infinity>() : 1.0;
+    J = J * cs.asDiagonal();
     Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeFullU);
     const auto& sv = svd.singularValues();
+    out.singular_values = std::vector<double>(sv.data(), sv.data() + sv.size());
     out.condition = sv(sv.size() - 1) > 0 ? sv(0) / sv(sv.size() - 1) : INFINITY;
     out.rank = 0;
     for (int i = 0; i < sv.size(); ++i)
