@@ -101,6 +101,7 @@ SolverOutcome solve_kinsol(NonlinearSystem& system, Eigen::VectorXd& x, const So
   KINSetFuncNormTol(k.mem, opt.tolerance);
   KINSetScaledStepTol(k.mem, 1e-15);
   KINSetNumMaxIters(k.mem, opt.max_iterations);
+  KINSetMaxNewtonStep(k.mem, 1e12);  // unknowns start at 0: the default (1000 x |u0|) is meaningless here
   KINSetPrintLevel(k.mem, 0);
   KINSetErrHandlerFn(k.mem, [](int, const char*, const char*, char*, void*) {}, nullptr);  // library never prints
 

@@ -26,7 +26,7 @@ struct ShootingOptions {
   int segments = 4;  // multiple shooting
   SolverOptions solver;
   NewtonOptions step;
-  double rank_tolerance = 1e-12;  // singular values of the equilibrated Jacobian below this times the largest count as zero
+  double rank_tolerance = 1e-10;  // singular values of the equilibrated Jacobian below this times the largest count as zero
   int threads = 0;               // 0: one per available core
 };
 
@@ -40,8 +40,7 @@ struct ShootingResult {
   std::vector<double> residual_history;
   double residual_norm = 0;
   double condition = 0;  // 2-norm condition of the equilibrated shooting Jacobian at the solution
-  // residual_norm is the max-norm of the residual with rows scaled by 1/|row of the Jacobian at
-  // the guess|: in units of the unknowns.
+  double raw_residual_norm = 0;  // max-norm of the conditions in their own units
   int rank = 0, unknowns = 0;
   std::vector<std::string> dependent_conditions;  // when rank deficient
   std::vector<double> singular_values;            // of the equilibrated Jacobian, descending
@@ -140,6 +139,30 @@ Eigen::VectorXd extended_difference(const BoundaryState<P>& a, const BoundarySta
   return v;
 }
 
+// Unknowns and continuity defects use a difference basis: the 2k nodes, 2k-1 increments and k
+// multipliers of a state are nearly equal neighbours (their differences scale like h^j), which
+// makes nodal coordinates ill-conditioned (cond ~ h^{-(2k-1)}); forward differences Δ^j of each
+// block, with the row/column equilibration, remove that. M maps tangent coordinates to these.
+template <class P>
+Eigen::MatrixXd difference_basis() {
+  using FS = FlowState<P>;
+  constexpr int k = P::order, r = P::shape_dim, d = P::Group::dim, m = P::num_constraints;
+  constexpr int n = BoundaryState<P>::size;
+  Eigen::MatrixXd M = Eigen::MatrixXd::Identity(n, n);
+  auto block = [&](int off, int L, int c) {
+    for (int j = 0; j < L; ++j)
+      for (int i = 0; i <= j; ++i) {
+        double binom = 1;
+        for (int t = 0; t < i; ++t) binom = binom * (j - t) / (t + 1);
+        for (int a = 0; a < c; ++a) M(off + j * c + a, off + i * c + a) = ((j - i) % 2 ? -1.0 : 1.0) * binom;
+      }
+  };
+  block(FS::p_offset(0), 2 * k, r);
+  block(FS::g_offset(0), 2 * k - 1, d);
+  block(FS::lam_offset(0), k, m);
+  return M;
+}
+
 // The shooting equations for S >= 1 segments between state indices s_0 = k < s_1 < ... < s_S = N-k+1.
 template <class P>
 class ShootingSystem : public NonlinearSystem {
@@ -148,13 +171,12 @@ class ShootingSystem : public NonlinearSystem {
   ShootingSystem(const BoundaryValueProblem<P>& bvp, std::vector<BoundaryState<P>> refs, std::vector<int> starts,
                  const NewtonOptions& step, int threads)
       : bvp_(bvp), refs_(std::move(refs)), starts_(std::move(starts)), flow_(bvp.problem, bvp.h(), step),
-        threads_(threads) {}
+        threads_(threads), M_(difference_basis<P>()), Minv_(M_.inverse()) {}
 
   int size() const override { return n * static_cast<int>(refs_.size()); }
   int segments() const { return static_cast<int>(refs_.size()); }
 
-  // Residual rows are scaled by w (set from the row norms of the Jacobian at the guess), so
-  // that each scaled residual measures how far the unknowns are from satisfying its condition.
+  // Residual rows may be scaled by w (none by default: the conditions are solved in their own units).
   bool residual(const Eigen::VectorXd& x, Eigen::VectorXd& F) override {
     if (!evaluate(x, F, nullptr)) return false;
     if (w_.size() == F.size()) F.array() *= w_.array();
@@ -167,6 +189,8 @@ class ShootingSystem : public NonlinearSystem {
     return true;
   }
   void set_row_scaling(const Eigen::VectorXd& w) { w_ = w; }
+  // The conditions in their own units (no row scaling).
+  bool raw_residual(const Eigen::VectorXd& x, Eigen::VectorXd& F) { return evaluate(x, F, nullptr); }
 
   // Runs all segments at x; fills the per-segment results. False if a flow failed.
   bool propagate(const Eigen::VectorXd& x, bool sensitivities, std::vector<FlowResult<P>>& runs,
@@ -176,7 +200,8 @@ class ShootingSystem : public NonlinearSystem {
     starts.resize(S);
     Jr.resize(S);
     for (int i = 0; i < S; ++i)
-      starts[i] = retract_extended(refs_[i], x.segment(i * n, n), sensitivities ? &Jr[i] : nullptr);
+      starts[i] = retract_extended(refs_[i], Eigen::VectorXd(Minv_ * x.segment(i * n, n)),
+                                   sensitivities ? &Jr[i] : nullptr);
     auto work = [&](int i) {
       const int N_local = starts_[i + 1] - starts_[i] + 2 * P::order - 1;
       const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(n, n);
@@ -228,6 +253,8 @@ class ShootingSystem : public NonlinearSystem {
     std::vector<Eigen::MatrixXd> Jr;
     if (!propagate(x, J != nullptr, runs, starts, Jr)) return false;
     const int S = segments(), N = size();
+    if (J)
+      for (auto& j : Jr) j = j * Minv_;  // d(tangent)/d(unknowns)
     F.resize(N);
     if (J) J->setZero(N, N);
     int row = 0;
@@ -239,13 +266,13 @@ class ShootingSystem : public NonlinearSystem {
     row += R.size();
     for (int i = 0; i + 1 < S; ++i) {  // continuity: end of segment i minus start of segment i+1
       const BoundaryState<P> e = end_state(runs[i]);
-      F.segment(row, n) = extended_difference(e, starts[i + 1]);
+      F.segment(row, n) = M_ * extended_difference(e, starts[i + 1]);
       if (J) {
         // d/d(end) of log(start^{-1} end) ≈ I and d/d(start) ≈ -I at the solution; exact forms:
         Eigen::MatrixXd De, Ds;
         difference_jacobians(e, starts[i + 1], De, Ds);
-        J->block(row, i * n, n, n) = De * runs[i].sensitivity * Jr[i];
-        J->block(row, (i + 1) * n, n, n) = Ds * Jr[i + 1];
+        J->block(row, i * n, n, n) = M_ * De * runs[i].sensitivity * Jr[i];
+        J->block(row, (i + 1) * n, n, n) = M_ * Ds * Jr[i + 1];
       }
       row += n;
     }
@@ -310,6 +337,7 @@ class ShootingSystem : public NonlinearSystem {
   DiscreteFlow<P> flow_;
   int threads_;
   std::string last_failure_;
+  Eigen::MatrixXd M_, Minv_;
   Eigen::VectorXd w_;
 };
 
@@ -353,16 +381,10 @@ ShootingResult<P> solve_bvp(const BoundaryValueProblem<P>& bvp, const ShootingGu
   out.unknowns = system.size();
 
   Eigen::VectorXd x = Eigen::VectorXd::Zero(system.size());
-  {  // Row scaling from the Jacobian at the guess.
-    Eigen::MatrixXd J0;
-    if (!system.jacobian(x, J0))
+  {  // The guess must be evaluable.
+    Eigen::VectorXd F0;
+    if (!system.residual(x, F0))
       return finish(ShootingStatus::FlowFailed, "the discrete flow failed from the initial guess: " + system.last_failure());
-    Eigen::VectorXd w(J0.rows());
-    for (int i = 0; i < J0.rows(); ++i) {
-      const double norm = J0.row(i).lpNorm<Eigen::Infinity>();
-      w(i) = norm > 0 ? 1.0 / norm : 1.0;
-    }
-    system.set_row_scaling(w);
   }
   const SolverOutcome so = solve_nonlinear(system, x, opt.solver);
   out.iterations = so.iterations;
@@ -385,12 +407,20 @@ ShootingResult<P> solve_bvp(const BoundaryValueProblem<P>& bvp, const ShootingGu
     tr.lam.insert(tr.lam.end(), t.lam.begin() + skip_l, t.lam.end());
   }
   out.g = reconstruct_group(bvp.problem, tr, st[0].g);
+  {
+    Eigen::VectorXd F;
+    out.raw_residual_norm = system.raw_residual(x, F) ? F.lpNorm<Eigen::Infinity>() : INFINITY;
+  }
   for (int j = 0; j + k <= tr.N(); ++j) out.cost += bvp.problem.lagrangian(tr.window_at(j), tr.h);
   if constexpr (G::dim > 0) out.momentum_drift = momentum_drift(bvp.problem, tr, st[0].g);
 
   // Conditioning and rank of the shooting Jacobian at the final iterate.
   Eigen::MatrixXd J;
-  if (system.jacobian(x, J)) {  // rows already scaled; scale the columns too for the rank decision
+  if (system.jacobian(x, J)) {  // equilibrate rows and columns for the rank decision
+    for (int r = 0; r < J.rows(); ++r) {
+      const double norm = J.row(r).lpNorm<Eigen::Infinity>();
+      if (norm > 0) J.row(r) /= norm;
+    }
     Eigen::VectorXd cs(J.cols());
     for (int c = 0; c < J.cols(); ++c) cs(c) = J.col(c).lpNorm<Eigen::Infinity>() > 0 ? 1.0 / J.col(c).lpNorm<Eigen::Infinity>() : 1.0;
     J = J * cs.asDiagonal();

@@ -35,7 +35,11 @@ TEST(ShootingElectron, ConvergesToTheExactOptimumAtTheClosuresOrder) {
   for (Closure c : {Closure::Paper, Closure::SecondOrder}) {
     std::vector<double> err, cost_err;
     for (int N : {25, 50, 100, 200, 400}) {
-      const auto r = solve(e, T, N, c);
+      // Single shooting's roundoff grows like N^4 eps (METHOD.md §5): segments of 25 steps.
+      ShootingOptions opt;
+      opt.method = ShootingMethod::Multiple;
+      opt.segments = N / 25;
+      const auto r = solve(e, T, N, c, opt);
       ASSERT_TRUE(r.ok()) << r.message;
       err.push_back(max_error(r, exact));
       cost_err.push_back(std::abs(r.cost - exact.cost));
