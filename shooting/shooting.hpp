@@ -14,7 +14,9 @@
 
 #include <Eigen/SVD>
 
+#include <algorithm>
 #include <chrono>
+#include <limits>
 #include <thread>
 
 namespace lpshoot {
@@ -41,6 +43,8 @@ struct ShootingResult {
   double residual_norm = 0;
   double condition = 0;  // 2-norm condition of the equilibrated shooting Jacobian at the solution
   double raw_residual_norm = 0;  // max-norm of the conditions in their own units
+  // residual_norm: max over rows of |F_i| / tolerance_i (<= 1 at convergence); tolerance_i is the
+  // solver tolerance plus the row's roundoff floor (see row_tolerances).
   int rank = 0, unknowns = 0;
   std::vector<std::string> dependent_conditions;  // when rank deficient
   std::vector<double> singular_values;            // of the equilibrated Jacobian, descending
@@ -139,27 +143,30 @@ Eigen::VectorXd extended_difference(const BoundaryState<P>& a, const BoundarySta
   return v;
 }
 
-// Unknowns and continuity defects use a difference basis: the 2k nodes, 2k-1 increments and k
-// multipliers of a state are nearly equal neighbours (their differences scale like h^j), which
-// makes nodal coordinates ill-conditioned (cond ~ h^{-(2k-1)}); forward differences Δ^j of each
-// block, with the row/column equilibration, remove that. M maps tangent coordinates to these.
+// Unknowns and continuity defects use a divided-difference basis: the 2k nodes, 2k-1 increments
+// and k multipliers of a state are nearly equal neighbours (their differences scale like h^j),
+// which makes nodal coordinates ill-conditioned (cond ~ h^{-(2k-1)}) and makes one tolerance
+// mean very different things per component. Forward differences Δ^j / h^j (increments, already
+// ~h: Δ^j / h^{j+1}) turn them into derivative-like quantities. M maps tangent coordinates to these.
 template <class P>
-Eigen::MatrixXd difference_basis() {
+Eigen::MatrixXd difference_basis(double h) {
   using FS = FlowState<P>;
   constexpr int k = P::order, r = P::shape_dim, d = P::Group::dim, m = P::num_constraints;
   constexpr int n = BoundaryState<P>::size;
   Eigen::MatrixXd M = Eigen::MatrixXd::Identity(n, n);
-  auto block = [&](int off, int L, int c) {
-    for (int j = 0; j < L; ++j)
+  auto block = [&](int off, int L, int c, int extra_power) {
+    for (int j = 0; j < L; ++j) {
+      const double scale = std::pow(h, -(j + extra_power));
       for (int i = 0; i <= j; ++i) {
         double binom = 1;
         for (int t = 0; t < i; ++t) binom = binom * (j - t) / (t + 1);
-        for (int a = 0; a < c; ++a) M(off + j * c + a, off + i * c + a) = ((j - i) % 2 ? -1.0 : 1.0) * binom;
+        for (int a = 0; a < c; ++a) M(off + j * c + a, off + i * c + a) = ((j - i) % 2 ? -1.0 : 1.0) * binom * scale;
       }
+    }
   };
-  block(FS::p_offset(0), 2 * k, r);
-  block(FS::g_offset(0), 2 * k - 1, d);
-  block(FS::lam_offset(0), k, m);
+  block(FS::p_offset(0), 2 * k, r, 0);
+  block(FS::g_offset(0), 2 * k - 1, d, 1);
+  block(FS::lam_offset(0), k, m, 0);
   return M;
 }
 
@@ -171,7 +178,7 @@ class ShootingSystem : public NonlinearSystem {
   ShootingSystem(const BoundaryValueProblem<P>& bvp, std::vector<BoundaryState<P>> refs, std::vector<int> starts,
                  const NewtonOptions& step, int threads)
       : bvp_(bvp), refs_(std::move(refs)), starts_(std::move(starts)), flow_(bvp.problem, bvp.h(), step),
-        threads_(threads), M_(difference_basis<P>()), Minv_(M_.inverse()) {}
+        threads_(threads), M_(difference_basis<P>(bvp.h())), Minv_(M_.inverse()) {}
 
   int size() const override { return n * static_cast<int>(refs_.size()); }
   int segments() const { return static_cast<int>(refs_.size()); }
@@ -189,6 +196,41 @@ class ShootingSystem : public NonlinearSystem {
     return true;
   }
   void set_row_scaling(const Eigen::VectorXd& w) { w_ = w; }
+
+  // Per-row tolerances: `tol` plus the roundoff floor of each row, 64 u |J_δ| |state|: the
+  // rounding of the state's values (magnitudes |state|) propagated through the row's derivative
+  // with respect to them (J_δ: the raw Jacobian in tangent coordinates, at x). It covers the
+  // divided differences of the continuity rows (the third divided difference of positions at
+  // h = 0.0025 cannot be known better than ~1e-8) and the flow's amplification over a segment.
+  Eigen::VectorXd row_tolerances(const Eigen::VectorXd& x, double tol) {
+    using G = typename P::Group;
+    using FS = FlowState<P>;
+    constexpr int k = P::order, r = P::shape_dim, d = G::dim, m = P::num_constraints;
+    const int S = segments();
+    Eigen::VectorXd F;
+    Eigen::MatrixXd J;
+    const Eigen::VectorXd w = w_;
+    w_.resize(0);
+    const bool ok = evaluate(x, F, &J);
+    w_ = w;
+    Eigen::VectorXd t = Eigen::VectorXd::Constant(size(), tol);
+    if (!ok) return t;
+    Eigen::VectorXd mag(size());
+    for (int i = 0; i < S; ++i) {
+      const BoundaryState<P>& ref = refs_[i];
+      Eigen::VectorXd v = Eigen::VectorXd::Ones(n);
+      for (int j = 0; j < 2 * k; ++j) v.segment(FS::p_offset(j), r) = ref.s.p[j].cwiseAbs().array().max(1.0);
+      for (int j = 0; j < 2 * k - 1; ++j) v.segment(FS::g_offset(j), d) = G::log(ref.s.g[j]).cwiseAbs().array().max(bvp_.h());
+      for (int j = 0; j < k; ++j) v.segment(FS::lam_offset(j), m) = ref.s.lam[j].cwiseAbs().array().max(1.0);
+      mag.segment(i * n, n) = v;
+    }
+    Eigen::MatrixXd Jd = J;  // J_x M = J_δ, per segment block of columns
+    for (int i = 0; i < S; ++i) Jd.middleCols(i * n, n) = J.middleCols(i * n, n) * M_;
+    const Eigen::ArrayXd floor = 64 * std::numeric_limits<double>::epsilon() * (Jd.cwiseAbs() * mag).array();
+    t.array() += floor.min(1e4 * tol);  // at most four digits conceded to roundoff: beyond, not converged
+    return t;
+  }
+
   // The conditions in their own units (no row scaling).
   bool raw_residual(const Eigen::VectorXd& x, Eigen::VectorXd& F) { return evaluate(x, F, nullptr); }
 
@@ -386,7 +428,11 @@ ShootingResult<P> solve_bvp(const BoundaryValueProblem<P>& bvp, const ShootingGu
     if (!system.residual(x, F0))
       return finish(ShootingStatus::FlowFailed, "the discrete flow failed from the initial guess: " + system.last_failure());
   }
-  const SolverOutcome so = solve_nonlinear(system, x, opt.solver);
+  // Rows scaled by 1/(their tolerance): the solver then stops at a max-norm of 1.
+  system.set_row_scaling(system.row_tolerances(x, opt.solver.tolerance).cwiseInverse());
+  SolverOptions scaled = opt.solver;
+  scaled.tolerance = 1.0;
+  const SolverOutcome so = solve_nonlinear(system, x, scaled);
   out.iterations = so.iterations;
   out.residual_history = so.residual_history;
   out.residual_norm = so.residual_norm;
