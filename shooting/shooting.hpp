@@ -12,6 +12,8 @@
 #include "boundary.hpp"
 #include "nonlinear_solver.hpp"
 
+#include <Eigen/LU>
+#include <Eigen/QR>
 #include <Eigen/SVD>
 
 #include <algorithm>
@@ -41,13 +43,13 @@ struct ShootingResult {
   int iterations = 0;
   std::vector<double> residual_history;
   double residual_norm = 0;
-  double condition = 0;  // 2-norm condition of the equilibrated shooting Jacobian at the solution
+  double condition = 0;  // 1-norm condition estimate of the equilibrated shooting Jacobian at the solution
   double raw_residual_norm = 0;  // max-norm of the conditions in their own units
   // residual_norm: max over rows of |F_i| / tolerance_i (<= 1 at convergence); tolerance_i is the
   // solver tolerance plus the row's roundoff floor (see row_tolerances).
   int rank = 0, unknowns = 0;
   std::vector<std::string> dependent_conditions;  // when rank deficient
-  std::vector<double> singular_values;            // of the equilibrated Jacobian, descending
+  std::vector<double> singular_values;            // of the equilibrated Jacobian, when rank deficient
   double wall_time_s = 0;
   Trajectory<P> trajectory;
   std::vector<GroupElement<P, double>> g;  // reconstructed g_0 .. g_N
@@ -470,14 +472,23 @@ ShootingResult<P> solve_bvp(const BoundaryValueProblem<P>& bvp, const ShootingGu
     Eigen::VectorXd cs(J.cols());
     for (int c = 0; c < J.cols(); ++c) cs(c) = J.col(c).lpNorm<Eigen::Infinity>() > 0 ? 1.0 / J.col(c).lpNorm<Eigen::Infinity>() : 1.0;
     J = J * cs.asDiagonal();
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeFullU);
-    const auto& sv = svd.singularValues();
-    out.singular_values = std::vector<double>(sv.data(), sv.data() + sv.size());
-    out.condition = sv(sv.size() - 1) > 0 ? sv(0) / sv(sv.size() - 1) : INFINITY;
+    // Rank by column-pivoted QR (cheap); the SVD only when the rank is deficient, to name the
+    // dependent conditions. Condition: 1-norm estimate from the LU.
+    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(J);
+    const Eigen::VectorXd rdiag = qr.matrixR().diagonal().cwiseAbs();
     out.rank = 0;
-    for (int i = 0; i < sv.size(); ++i)
-      if (sv(i) > opt.rank_tolerance * sv(0)) ++out.rank;
+    for (int i = 0; i < rdiag.size(); ++i)
+      if (rdiag(i) > opt.rank_tolerance * rdiag(0)) ++out.rank;
+    const double rc = Eigen::PartialPivLU<Eigen::MatrixXd>(J).rcond();
+    out.condition = rc > 0 ? 1.0 / rc : INFINITY;
     if (out.rank < out.unknowns) {
+      Eigen::BDCSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeThinU);
+      const auto& sv = svd.singularValues();
+      out.singular_values = std::vector<double>(sv.data(), sv.data() + sv.size());
+      int rank = 0;
+      for (int i = 0; i < sv.size(); ++i)
+        if (sv(i) > opt.rank_tolerance * sv(0)) ++rank;
+      out.rank = std::min(out.rank, rank);
       const auto names = system.row_names();
       for (int c = out.rank; c < sv.size(); ++c) {  // left null vectors: dependent conditions
         const Eigen::VectorXd u = svd.matrixU().col(c);
