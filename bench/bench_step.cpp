@@ -15,10 +15,7 @@ FlowState<BeanieControl> beanie_state(const BeanieControl& b, double h) {
   FlowState<BeanieControl> s;
   for (int i = 0; i < 4; ++i) s.p[i] = Vec<double, 1>(0.5 + 0.8 * i * h - 0.25 * (i * h) * (i * h));
   s.g[0] = {0.6 * h, Eigen::Vector2d(0.8 * h, -0.3 * h)};
-  for (int i = 1; i < 3; ++i) {
-    const double beta = s.g[i - 1].angle - b.par.c() * (s.p[i](0) - s.p[i - 1](0));
-    s.g[i] = {s.g[i - 1].angle, SO2::rotation(-beta) * s.g[i - 1].t};
-  }
+  for (int i = 1; i < 3; ++i) s.g[i] = b.next_increment(s.g[i - 1], s.p[i](0) - s.p[i - 1](0));
   s.lam = {Eigen::Vector3d(0.3, -0.2, 0.1), Eigen::Vector3d(0.302, -0.199, 0.101)};
   return s;
 }

@@ -89,8 +89,7 @@ std::string check_counting(const BoundaryValueProblem<P>& bvp) {
       if (c.offset < 0 || c.offset >= k || c.component < 0 || c.component >= nc)
         return "condition '" + c.name + "' names node offset " + std::to_string(c.offset) + ", component " +
                std::to_string(c.component) + " outside the boundary (k = " + std::to_string(k) + ")";
-      const int last = c.kind == ConditionKind::FixedIncrement ? c.component : c.component;
-      claims[c.offset * nc + last] += 1;
+      claims[c.offset * nc + c.component] += 1;
     }
     const char* end = e == End::Initial ? "initial" : "terminal";
     for (int o = 0; o < k; ++o)

@@ -35,15 +35,7 @@ inline FlowState<BeanieControl> beanie_control_initial(const BeanieControl& b, c
     s.p[i] = Vec<double, 1>(psi[i]);
   }
   s.g[0] = {h * Omega(2), h * Omega.head<2>()};
-  for (int i = 1; i < 3; ++i) {
-    const double beta = s.g[i - 1].angle - b.par.c() * (psi[i] - psi[i - 1]);
-    Eigen::Matrix2d J;
-    J << 0, -1, 1, 0;
-    const Eigen::Matrix2d rot = b.variant == problems::BeanieConstraints::ExactRotation
-                                    ? SO2::rotation(-beta)
-                                    : Eigen::Matrix2d(Eigen::Matrix2d::Identity() - beta * J);
-    s.g[i] = {s.g[i - 1].angle, rot * s.g[i - 1].t};
-  }
+  for (int i = 1; i < 3; ++i) s.g[i] = b.next_increment(s.g[i - 1], psi[i] - psi[i - 1]);
   s.lam = {lam0, lam1};
   return s;
 }

@@ -119,6 +119,15 @@ struct BeanieControl {
   SE2::Element<T> connection(const Vec<T, 1>& p0, const Vec<T, 1>& p1) const {
     return beanie_connection(par, p0, p1);
   }
+  // The increment g~_{n+1} that satisfies chi(a_n) = 0 given g~_n and Δψ_n (Ω3 kept, Ω12 rotated
+  // by Rot(β), β = angle(g~_n) - c Δψ_n): used to build initial data and guesses.
+  SE2::Element<double> next_increment(const SE2::Element<double>& g, double dpsi) const {
+    const double beta = g.angle - par.c() * dpsi;
+    const Eigen::Vector2d t = variant == BeanieConstraints::ExactRotation
+                                  ? Eigen::Vector2d(SO2::rotation(-beta) * g.t)
+                                  : Eigen::Vector2d(g.t(0) + beta * g.t(1), g.t(1) - beta * g.t(0));
+    return {g.angle, t};
+  }
 };
 
 }  // namespace lpshoot::problems

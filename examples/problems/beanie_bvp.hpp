@@ -86,10 +86,7 @@ inline ShootingGuess<BeanieControl> beanie_guess(const BoundaryValueProblem<Bean
   SE2::Element<double> inc{h * Omega3, h * Eigen::Vector2d(start.Omega1.value_or(0.0), start.Omega2.value_or(0.0))};
   for (int n = 0; n < bvp.N; ++n) {
     tr.g.push_back(inc);
-    const double beta = inc.angle - c * (tr.p[n + 1](0) - tr.p[n](0));
-    const Eigen::Matrix2d J = (Eigen::Matrix2d() << 0, -1, 1, 0).finished();
-    inc.t = b.variant == BeanieConstraints::ExactRotation ? Eigen::Vector2d(SO2::rotation(-beta) * inc.t)
-                                                          : Eigen::Vector2d(inc.t - beta * J * inc.t);
+    inc = b.next_increment(inc, tr.p[n + 1](0) - tr.p[n](0));
   }
   tr.lam.assign(bvp.N - 1, Eigen::Vector3d::Zero());
   guess.g0 = {start.theta.value_or(0.0), Eigen::Vector2d(start.x.value_or(0.0), start.y.value_or(0.0))};
