@@ -22,6 +22,8 @@ struct KinsolData {
   Eigen::MatrixXd J;
   std::exception_ptr error;
   std::vector<double>* history;
+  const SolverOptions* options;
+  int jacobians = 0;
 };
 
 Eigen::Map<Eigen::VectorXd> view(N_Vector v) {
@@ -51,6 +53,10 @@ int kin_jacobian(N_Vector u, N_Vector, SUNMatrix Jm, void* user, N_Vector, N_Vec
       sunrealtype* col = SUNDenseMatrix_Column(Jm, c);
       for (sunindextype r = 0; r < n; ++r) col[r] = d->J(r, c);
     }
+    // KINSOL evaluates F at u before the Jacobian there: d->F is F(u).
+    const double norm = d->F.lpNorm<Eigen::Infinity>();
+    if (++d->jacobians > 1) d->history->push_back(norm);  // the start is recorded before KINSol
+    if (d->options->on_iteration) d->options->on_iteration(d->jacobians, norm);
     return 0;
   } catch (...) {
     d->error = std::current_exception();
@@ -83,7 +89,7 @@ struct Kinsol {
 SolverOutcome solve_kinsol(NonlinearSystem& system, Eigen::VectorXd& x, const SolverOptions& opt) {
   SolverOutcome out;
   const int n = system.size();
-  KinsolData data{&system, x, Eigen::VectorXd(n), Eigen::MatrixXd(n, n), nullptr, &out.residual_history};
+  KinsolData data{&system, x, Eigen::VectorXd(n), Eigen::MatrixXd(n, n), nullptr, &out.residual_history, &opt};
   Kinsol k;
   if (SUNContext_Create(nullptr, &k.ctx) != 0) throw std::runtime_error("KINSOL: cannot create a context");
   k.u = N_VNew_Serial(n, k.ctx);

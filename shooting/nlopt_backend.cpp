@@ -16,8 +16,10 @@ struct NloptData {
   Eigen::VectorXd x, F;
   Eigen::MatrixXd J;
   std::exception_ptr error;
-  int evaluations = 0;
+  int evaluations = 0, jacobians = 0;
   bool failed = false;
+  const SolverOptions* options = nullptr;
+  std::vector<double>* history = nullptr;
 };
 
 void constraints(unsigned m, double* result, unsigned n, const double* x, double* grad, void* user) {
@@ -37,6 +39,9 @@ void constraints(unsigned m, double* result, unsigned n, const double* x, double
       }
       // NLopt wants grad[i * n + j] = dF_i / dx_j (row major).
       Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(grad, m, n) = d->J;
+      const double norm = d->F.lpNorm<Eigen::Infinity>();
+      if (++d->jacobians > 1) d->history->push_back(norm);  // the start is recorded before optimize
+      if (d->options->on_iteration) d->options->on_iteration(d->jacobians, norm);
     }
   } catch (const nlopt::forced_stop&) {
     throw;
@@ -56,6 +61,8 @@ SolverOutcome solve_nlopt(NonlinearSystem& system, Eigen::VectorXd& x, const Sol
   SolverOutcome out;
   const int n = system.size();
   NloptData data{&system, x, Eigen::VectorXd(n), Eigen::MatrixXd(n, n), nullptr};
+  data.options = &opt;
+  data.history = &out.residual_history;
   nlopt::opt o(nlopt::LD_SLSQP, n);
   o.set_min_objective(zero_objective, nullptr);
   o.add_equality_mconstraint(constraints, &data, std::vector<double>(n, opt.tolerance * 0.1));

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,9 @@ struct SolverOptions {
   Backend backend = Backend::Kinsol;
   double tolerance = 1e-10;  // max-norm of F at a solution
   int max_iterations = 50;
+  // Called at each Jacobian evaluation (one per iteration) with the iteration number (1, 2, ...)
+  // and the max-norm of F there: for progress displays. Must not throw.
+  std::function<void(int, double)> on_iteration;
 };
 
 enum class SolverStatus { Converged, NotConverged, Failed };

@@ -3,31 +3,16 @@
 #pragma once
 
 #include <lpshoot/problems/beanie.hpp>
-#include <lpshoot/problems/electron.hpp>
+#include <lpshoot/problems/electron_exact.hpp>
 
 #include <string>
 #include <vector>
 
 namespace lpshoot::oracles {
 
-// Electron, METHOD.md §6.1, with general constant B and φ(x) = potential |x|^2. With
-// K v = (e/c) B × v (skew), u = m x'' + K x' + 2κ x and min ½ ∫_0^T |u|^2 gives the
-// Euler–Lagrange equation m u'' + K u' + 2κ u = 0. The first-order system y' = A y with
-// y = (x, x', u, u') is linear, so y(t) = expm(A t) y(0) exactly; u(0), u'(0) come from a 6×6
-// linear solve that hits x(T), x'(T).
-struct ElectronOptimum {
-  Eigen::Matrix<double, 12, 12> A;
-  Eigen::Matrix<double, 12, 1> y0;  // y = (x, x', u, u') at t = 0
-  Eigen::Matrix<double, 12, 1> state(double t) const;  // expm(A t) y0
-  Eigen::Vector3d position(double t) const { return state(t).segment<3>(0); }
-  Eigen::Vector3d velocity(double t) const { return state(t).segment<3>(3); }
-  Eigen::Vector3d control(double t) const { return state(t).segment<3>(6); }
-  double cost = 0;  // ½ ∫_0^T |u|^2 dt, by Van Loan's block exponential
-};
-
-ElectronOptimum electron_exact_optimum(const problems::Electron& e, double T, const Eigen::Vector3d& x0,
-                                       const Eigen::Vector3d& v0, const Eigen::Vector3d& xT,
-                                       const Eigen::Vector3d& vT);
+// Electron: the exact optimum lives with the problem (it also serves `lpshoot sweep`).
+using problems::ElectronOptimum;
+using problems::electron_exact_optimum;
 
 // Elroy's beanie, METHOD.md §6.2, with natural terminal conditions (zero multipliers): the shape
 // solves min ½ ∫_0^T u^2, u = μ ψ'' + V'(ψ), with ψ, ψ' given at both ends. Necessary conditions:

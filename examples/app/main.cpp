@@ -1,0 +1,187 @@
+// lpshoot: the command-line application (CLI11 stays in this file).
+//   lpshoot solve SCENE.json [--out DIR] [--set key.path=value ...]
+//   lpshoot simulate SCENE.json [...]
+//   lpshoot sweep SCENE.json --N 50,100,200 [--method single,multiple] [--backend kinsol,nlopt]
+//   lpshoot check SCENE.json
+// Exit codes: 0 converged; 1 the run did not converge (the report says why); 2 bad command line
+// or scene; 3 the results could not be written.
+#include "output.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <unistd.h>
+
+#include <cstdio>
+
+namespace {
+
+using namespace lpshoot;
+using namespace lpshoot::app;
+
+struct Common {
+  std::string scene, out;
+  std::vector<std::string> sets;
+  bool no_plot = false, progress = false, quiet = false;
+};
+
+Progress progress_printer(const Common& c) {
+  if (c.quiet || !(c.progress || isatty(STDERR_FILENO))) return {};
+  return [](const std::string& line) { std::fprintf(stderr, "  %s\n", line.c_str()); };
+}
+
+std::string fmt(const char* f, double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, x);
+  return buf;
+}
+
+void print_files(const Written& w) {
+  for (const auto& warning : w.warnings) std::fprintf(stderr, "lpshoot: warning: %s\n", warning.c_str());
+  std::printf("wrote:");
+  for (const auto& f : w.files) std::printf(" %s", f.c_str());
+  std::printf("\n");
+}
+
+void print_run(const RunRecord& r) {
+  std::printf("%s %s: N = %d, T = %g, h = %g", r.command.c_str(), r.problem.c_str(), r.N, r.T, r.h);
+  if (!r.method.empty())
+    std::printf(", %s shooting%s, %s, %s closure%s%s", r.method.c_str(),
+                r.segments > 1 ? (" (" + std::to_string(r.segments) + " segments)").c_str() : "", r.backend.c_str(),
+                r.closure.c_str(), r.constraints.empty() ? "" : ", constraints ", r.constraints.c_str());
+  std::printf("\nstatus: %s (%s)\n", r.status.c_str(), r.message.c_str());
+  if (r.command == "solve")
+    std::printf("residual: %s x tolerance (raw %s), Jacobian condition %s, rank %d of %d\n",
+                fmt("%.3g", r.residual_norm).c_str(), fmt("%.3g", r.raw_residual_norm).c_str(),
+                fmt("%.3g", r.condition).c_str(), r.rank, r.unknowns);
+  else
+    std::printf("Newton: %d iterations over all steps, max step residual %s, max step condition %s\n", r.iterations,
+                fmt("%.3g", r.residual_norm).c_str(), fmt("%.3g", r.condition).c_str());
+  if (!r.converged) return;
+  if (r.has_cost) std::printf("cost: %.15g\n", r.cost);
+  else std::printf("action: %.15g\n", r.action);
+  if (r.has_momentum)
+    std::printf("momentum drift: max_n |J_n - J_0| = %.3e (relative %.3e)\n", r.momentum_drift, r.momentum_drift_relative);
+  std::printf("final:");
+  for (const auto& [k, v] : r.final_state) std::printf(" %s = %.10g", k.c_str(), v);
+  std::printf("\nwall time: %.3f s\n", r.wall_time_s);
+}
+
+void print_sweep(const SweepRecord& sw) {
+  std::printf("sweep %s: errors against the %s, max over nodes of |", sw.problem.c_str(), sw.reference.c_str());
+  for (size_t i = 0; i < sw.error_columns.size(); ++i) std::printf("%s%s", i ? ", " : "", sw.error_columns[i].c_str());
+  std::printf("|\n%7s %10s %-22s %-13s %10s %6s %12s %10s %9s %5s\n", "N", "h", "solver", "status", "error", "order",
+              "cost", "cost err", "time [s]", "iter");
+  for (const auto& r : sw.runs) {
+    const std::string solver = r.method.empty() ? "flow" : r.method + (r.segments > 1 ? "(" + std::to_string(r.segments) + ")" : "") + "/" + r.backend;
+    auto opt = [](const char* f, double x) { return std::isfinite(x) ? fmt(f, x) : std::string("-"); };
+    std::printf("%7d %10.4g %-22s %-13s %10s %6s %12s %10s %9.4f %5d\n", r.N, r.h, solver.c_str(), r.status.c_str(),
+                opt("%.3e", r.error).c_str(), opt("%.2f", r.order).c_str(), opt("%.8g", r.cost).c_str(),
+                opt("%.2e", r.cost_error).c_str(), r.wall_time_s, r.iterations);
+  }
+}
+
+int fail_input(const std::string& what) {
+  std::fprintf(stderr, "lpshoot: %s\n", what.c_str());
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"lpshoot: optimal and free trajectories of mechanical systems with symmetry\n"
+               "(discrete constrained higher-order Lagrange-Poincare equations, Bloch-Colombo-Jimenez)"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "lpshoot 0.1.0");
+  Common c;
+  auto scene_options = [&](CLI::App* sub, bool outputs) {
+    sub->add_option("scene", c.scene, "the scene file (JSON; see the README's scene reference)")->required();
+    sub->add_option("--set", c.sets, "override a scene value, key.path=value (repeatable; value JSON or a word; null frees it)");
+    if (!outputs) return;
+    sub->add_option("--out", c.out, "output directory (default: the scene's output.dir, else lpshoot-out/SCENE)");
+    sub->add_flag("--no-plot", c.no_plot, "do not draw PNG plots");
+    sub->add_flag("--progress", c.progress, "show progress even when stderr is not a terminal");
+    sub->add_flag("--quiet", c.quiet, "no progress lines");
+  };
+  CLI::App* solve = app.add_subcommand("solve", "solve the scene's boundary value problem (optimal control)");
+  CLI::App* simulate = app.add_subcommand("simulate", "run the discrete flow from the scene's initial data");
+  CLI::App* sweep = app.add_subcommand("sweep", "solve or simulate over several grids/solvers: error, order, time");
+  CLI::App* check = app.add_subcommand("check", "validate the scene only");
+  scene_options(solve, true);
+  scene_options(simulate, true);
+  scene_options(sweep, true);
+  scene_options(check, false);
+  std::vector<int> grids;
+  std::vector<std::string> methods, backends;
+  int steps_per_segment = 0;
+  std::string reference = "auto";
+  sweep->add_option("--N", grids, "grids, comma separated (e.g. 50,100,200,400)")->required()->delimiter(',');
+  sweep->add_option("--method", methods, "shooting methods to compare (single,multiple)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"single", "multiple"}));
+  sweep->add_option("--backend", backends, "solver backends to compare (kinsol,nlopt)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"kinsol", "nlopt"}));
+  sweep->add_option("--steps-per-segment", steps_per_segment, "multiple shooting: segments = ceil(N / this)")
+      ->check(CLI::PositiveNumber);
+  sweep->add_option("--reference", reference, "error reference: auto (exact where available) or finest")
+      ->check(CLI::IsMember({"auto", "finest"}));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+
+  Scene scene;
+  try {
+    scene = load_scene(c.scene, c.sets);
+    if (const std::string why = check_boundary(scene); !why.empty())
+      return fail_input(scene.file + ": boundary: " + why);
+  } catch (const SceneError& e) {
+    return fail_input(e.what());
+  }
+  if (check->parsed()) {
+    std::printf("%s: valid %s scene: N = %d, T = %g, h = %g\n", scene.file.c_str(), scene.problem_name.c_str(), scene.N,
+                scene.T, scene.h());
+    return 0;
+  }
+  const std::string dir = c.out.empty() ? scene.out_dir : c.out;
+  const bool plot = scene.plot && !c.no_plot;
+  const Progress progress = progress_printer(c);
+  try {
+    if (sweep->parsed()) {
+      SweepOptions so;
+      so.N = grids;
+      for (const auto& m : methods) so.methods.push_back(m == "multiple" ? ShootingMethod::Multiple : ShootingMethod::Single);
+      for (const auto& b : backends) so.backends.push_back(b == "nlopt" ? Backend::Nlopt : Backend::Kinsol);
+      if (!scene.is_optimal_control() && (!so.methods.empty() || !so.backends.empty() || steps_per_segment > 0))
+        return fail_input("--method/--backend/--steps-per-segment: a " + scene.problem_name +
+                          " simulation has no shooting solver to choose");
+      so.steps_per_segment = steps_per_segment;
+      so.use_exact = reference == "auto";
+      const SweepRecord sw = run_sweep(scene, scene.is_optimal_control() ? "solve" : "simulate", so, progress);
+      print_sweep(sw);
+      print_files(write_sweep(scene, sw, dir, plot));
+      if (!sw.all_converged) {
+        std::fprintf(stderr, "lpshoot: not every run converged: %s\n", sw.message.c_str());
+        return 1;
+      }
+      return 0;
+    }
+    const RunRecord r = run_scene(solve->parsed() ? "solve" : "simulate", scene, progress);
+    print_run(r);
+    print_files(write_run(scene, r, dir, plot));
+    if (!r.converged) {
+      std::fprintf(stderr, "lpshoot: %s: %s\n", r.status.c_str(), r.message.c_str());
+      return 1;
+    }
+    return 0;
+  } catch (const SceneError& e) {
+    return fail_input(e.what());
+  } catch (const OutputError& e) {
+    std::fprintf(stderr, "lpshoot: cannot write the results: %s\n", e.what());
+    return 3;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "lpshoot: internal error: %s\n", e.what());
+    return 4;
+  }
+}

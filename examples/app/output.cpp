@@ -1,0 +1,314 @@
+// Writing results (nlohmann-json stays here and in scene.cpp).
+#include "output.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace lpshoot::app {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::ordered_json;
+
+void ensure_dir(const fs::path& dir) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir)) throw OutputError(dir.string() + ": cannot create the output directory" + (ec ? ": " + ec.message() : ""));
+}
+
+// Writes to DIR/.NAME.tmp, then renames over DIR/NAME.
+void write_atomic(const fs::path& dir, const std::string& name, const std::string& content) {
+  const fs::path tmp = dir / ("." + name + ".tmp"), dst = dir / name;
+  {
+    std::ofstream f(tmp, std::ios::binary);
+    f << content;
+    f.close();
+    if (!f) {
+      std::error_code ec;
+      fs::remove(tmp, ec);
+      throw OutputError(dst.string() + ": cannot write");
+    }
+  }
+  std::error_code ec;
+  fs::rename(tmp, dst, ec);
+  if (ec) throw OutputError(dst.string() + ": cannot move into place: " + ec.message());
+}
+
+void remove_stale(const fs::path& dir, const std::vector<std::string>& names) {
+  for (const auto& n : names) {
+    std::error_code ec;
+    fs::remove(dir / n, ec);
+  }
+}
+
+std::string number(double x) {  // full precision; empty for "no value"
+  if (!std::isfinite(x)) return "";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", x);
+  return buf;
+}
+
+std::string csv(const Table& t) {
+  std::string s;
+  for (size_t c = 0; c < t.names.size(); ++c) s += (c ? "," : "") + t.names[c];
+  s += "\n";
+  for (size_t r = 0; r < t.rows(); ++r) {
+    for (size_t c = 0; c < t.columns.size(); ++c) s += (c ? "," : "") + number(t.columns[c][r]);
+    s += "\n";
+  }
+  return s;
+}
+
+json finite_or_null(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
+
+std::string quote_shell(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+// Runs gnuplot on DIR/plot.gp (which writes .NAME.tmp files), then moves each PNG into place.
+void run_gnuplot(const fs::path& dir, const std::string& script, const std::vector<std::string>& pngs, Written& w) {
+  write_atomic(dir, "plot.gp", script);
+  remove_stale(dir, pngs);
+  const std::string cmd = "cd " + quote_shell(dir.string()) + " && gnuplot plot.gp > .gnuplot.log 2>&1";
+  const int rc = std::system(cmd.c_str());
+  const int code = rc == -1 ? -1 : WEXITSTATUS(rc);
+  if (code != 0) {
+    std::string why = code == 127 ? "gnuplot is not installed (apt-get install gnuplot-nox)" : "gnuplot failed";
+    std::ifstream log(dir / ".gnuplot.log");
+    std::string line;
+    if (code != 127 && std::getline(log, line)) why += ": " + line;
+    w.warnings.push_back("plots skipped: " + why + " (script kept in " + (dir / "plot.gp").string() + ")");
+    for (const auto& p : pngs) remove_stale(dir, {"." + p + ".tmp"});
+    return;
+  }
+  remove_stale(dir, {".gnuplot.log"});
+  for (const auto& p : pngs) {
+    std::error_code ec;
+    fs::rename(dir / ("." + p + ".tmp"), dir / p, ec);
+    if (ec)
+      w.warnings.push_back("plot " + p + " was not produced");
+    else
+      w.files.push_back((dir / p).string());
+  }
+  w.files.push_back((dir / "plot.gp").string());
+}
+
+std::string gp_header(const std::string& out, int width, int height) {
+  std::ostringstream s;
+  s << "set terminal pngcairo size " << width << "," << height << " font ',10'\n"
+    << "set output '." << out << ".tmp'\n";
+  return s.str();
+}
+
+std::string lines(const std::string& file, const std::string& x, const std::string& y, const std::string& title) {
+  return "'" + file + "' using '" + x + "':'" + y + "' with lines lw 2 title '" + title + "'";
+}
+
+std::string run_plot_script(const Scene& scene, const RunRecord& r, bool momentum_plot) {
+  std::ostringstream s;
+  s << "# lpshoot plots: run `gnuplot plot.gp` in this directory to redraw.\n"
+    << "set datafile separator ','\nset key autotitle columnhead\nset grid\n";
+  s << gp_header("trajectory.png", 1500, 450);
+  char title[200];
+  std::snprintf(title, sizeof title, "%s (%s): N = %d, h = %.4g%s", r.problem.c_str(), r.command.c_str(), r.N, r.h,
+                r.has_cost ? (", cost " + number(r.cost).substr(0, 10)).c_str() : "");
+  s << "set multiplot layout 1,3 title \"" << title << "\"\n";
+  const std::string f = "trajectory.csv";
+  if (scene.problem == ProblemKind::Electron) {
+    s << "set title 'plane path'\nset xlabel 'x1'\nset ylabel 'x2'\nset size ratio -1\n"
+      << "plot " << lines(f, "x1", "x2", "(x1, x2)") << "\nset size noratio\n"
+      << "set title 'position'\nset xlabel 't'\nset ylabel ''\n"
+      << "plot " << lines(f, "t", "x1", "x1") << ", " << lines(f, "t", "x2", "x2") << ", " << lines(f, "t", "x3", "x3") << "\n"
+      << "set title 'control u'\n"
+      << "plot " << lines(f, "t", "u1", "u1") << ", " << lines(f, "t", "u2", "u2") << ", " << lines(f, "t", "u3", "u3") << "\n";
+  } else {
+    s << "set title 'plane path'\nset xlabel 'x'\nset ylabel 'y'\nset size ratio -1\n"
+      << "plot " << lines(f, "x", "y", "(x, y)") << "\nset size noratio\n"
+      << "set title 'shape and orientation'\nset xlabel 't'\nset ylabel ''\n"
+      << "plot " << lines(f, "t", "psi", "psi") << ", " << lines(f, "t", "theta", "theta") << "\n";
+    if (scene.problem == ProblemKind::Beanie)
+      s << "set title 'control u'\nplot " << lines(f, "t", "u", "u") << "\n";
+    else
+      s << "set title 'body velocity'\nplot " << lines(f, "t", "Omega1", "Omega1") << ", "
+        << lines(f, "t", "Omega2", "Omega2") << ", " << lines(f, "t", "Omega3", "Omega3") << "\n";
+  }
+  s << "unset multiplot\nset output\n";
+  if (momentum_plot) {
+    s << gp_header("momentum.png", 800, 500) << "set title 'spatial momentum drift max_i |J_n - J_0|_i'\n"
+      << "set xlabel 't'\nset ylabel ''\nset size noratio\n";
+    if (r.momentum_drift > 0)
+      s << "set logscale y\nset format y '10^{%L}'\n"
+        << "plot 'momentum.csv' using 't':(column('drift') > 0 ? column('drift') : NaN) with points pt 7 ps 0.4 "
+           "title '|J_n - J_0| (zeros not shown)'\n";
+    else
+      s << "set yrange [-1:1]\nplot 'momentum.csv' using 't':'drift' with lines lw 2 title '|J_n - J_0| (exactly 0)'\n";
+    s << "set output\n";
+  }
+  return s.str();
+}
+
+}  // namespace
+
+Written write_run(const Scene& scene, const RunRecord& r, const std::string& dir_name, bool plot) {
+  const fs::path dir(dir_name);
+  ensure_dir(dir);
+  Written w;
+  const std::vector<std::string> results = {"trajectory.csv", "momentum.csv", "trajectory.png", "momentum.png", "plot.gp"};
+  if (r.converged) {
+    write_atomic(dir, "trajectory.csv", csv(r.trajectory));
+    w.files.push_back((dir / "trajectory.csv").string());
+    if (r.has_momentum) {
+      write_atomic(dir, "momentum.csv", csv(r.momentum));
+      w.files.push_back((dir / "momentum.csv").string());
+    } else {
+      remove_stale(dir, {"momentum.csv", "momentum.png"});
+    }
+    if (plot) {
+      std::vector<std::string> pngs = {"trajectory.png"};
+      if (r.has_momentum) pngs.push_back("momentum.png");
+      run_gnuplot(dir, run_plot_script(scene, r, r.has_momentum), pngs, w);
+    }
+  } else {
+    remove_stale(dir, results);  // never leave a previous run's results next to a failed report
+  }
+
+  json j;
+  j["lpshoot_version"] = "0.1.0";
+  j["command"] = r.command;
+  j["status"] = r.status;
+  j["converged"] = r.converged;
+  j["message"] = r.message;
+  j["problem"] = r.problem;
+  j["scene_file"] = scene.file;
+  j["T"] = r.T;
+  j["N"] = r.N;
+  j["h"] = r.h;
+  if (!r.method.empty()) {
+    j["method"] = r.method;
+    j["segments"] = r.segments;
+    j["backend"] = r.backend;
+    j["closure"] = r.closure;
+  } else {
+    j["method"] = "discrete flow (Newton per step)";
+    j["backend"] = "lpshoot step Newton";
+  }
+  if (!r.constraints.empty()) j["constraints"] = r.constraints;
+  j["tolerance"] = r.tolerance;
+  j["cost"] = r.has_cost ? finite_or_null(r.cost) : json(nullptr);
+  j["action"] = finite_or_null(r.action);
+  j["iterations"] = r.iterations;
+  j["residual_norm"] = finite_or_null(r.residual_norm);
+  if (r.command == "solve") {
+    j["raw_residual_norm"] = finite_or_null(r.raw_residual_norm);
+    j["residual_history"] = json::array();
+    for (double x : r.residual_history) j["residual_history"].push_back(finite_or_null(x));
+    j["condition"] = finite_or_null(r.condition);
+    j["rank"] = r.rank;
+    j["unknowns"] = r.unknowns;
+    if (!r.dependent_conditions.empty()) j["dependent_conditions"] = r.dependent_conditions;
+  } else {
+    j["condition"] = finite_or_null(r.condition);  // the largest per-step Newton condition number
+  }
+  if (r.has_momentum) {
+    j["momentum_drift"] = r.momentum_drift;
+    j["momentum_drift_relative"] = r.momentum_drift_relative;
+    j["momentum_initial"] = r.momentum_initial;
+  } else {
+    j["momentum_drift"] = r.converged && r.problem == "electron" ? json(0.0) : json(nullptr);
+    j["momentum_note"] = r.problem == "electron" ? "the symmetry group is trivial: no momentum map to conserve"
+                                                 : "no trajectory";
+  }
+  j["wall_time_s"] = r.wall_time_s;
+  json fin = json::object();
+  for (const auto& [k, v] : r.final_state) fin[k] = finite_or_null(v);
+  j["final_state"] = fin;
+  w.files.insert(w.files.begin(), (dir / "report.json").string());
+  j["files"] = w.files;
+  j["warnings"] = w.warnings;
+  j["scene"] = json::parse(scene.effective_json);
+  write_atomic(dir, "report.json", j.dump(2) + "\n");
+  return w;
+}
+
+Written write_sweep(const Scene& scene, const SweepRecord& sw, const std::string& dir_name, bool plot) {
+  const fs::path dir(dir_name);
+  ensure_dir(dir);
+  Written w;
+  // The CSV carries the solver as text columns; build it by hand.
+  std::string s = "N,h,method,backend,segments,converged,error,order,cost,cost_error,wall_time_s,iterations,momentum_drift\n";
+  for (size_t i = 0; i < sw.runs.size(); ++i) {
+    const auto& r = sw.runs[i];
+    s += std::to_string(r.N) + "," + number(r.h) + "," + r.method + "," + r.backend + "," + std::to_string(r.segments) +
+         "," + (r.converged ? "1" : "0") + "," + number(r.error) + "," + number(r.order) + "," + number(r.cost) + "," +
+         number(r.cost_error) + "," + number(r.wall_time_s) + "," + std::to_string(r.iterations) + "," +
+         number(r.momentum_drift) + "\n";
+  }
+  write_atomic(dir, "sweep.csv", s);
+  w.files.push_back((dir / "sweep.csv").string());
+  if (plot) {
+    std::ostringstream g;
+    g << "# lpshoot sweep plot: run `gnuplot plot.gp` in this directory to redraw.\n"
+      << "set datafile separator ','\nset grid\nset logscale xy\nset format y '10^{%L}'\n"
+      << gp_header("sweep_error_time.png", 900, 600) << "set xlabel 'wall time [s]'\nset ylabel 'max error vs "
+      << (sw.reference.rfind("exact", 0) == 0 ? "exact solution" : "finest grid") << "'\n"
+      << "set title '" << sw.problem << ": error against cost (labels: N)'\n";
+    std::vector<std::string> solvers;
+    for (const auto& r : sw.runs)
+      if (std::find(solvers.begin(), solvers.end(), r.method + "," + r.backend) == solvers.end())
+        solvers.push_back(r.method + "," + r.backend);
+    g << "plot ";
+    for (size_t i = 0; i < solvers.size(); ++i) {
+      const std::string sel = "(strcol(3).','.strcol(4) eq '" + solvers[i] + "' ? column(7) : NaN)";
+      const std::string name = solvers[i] == "," ? "discrete flow" : solvers[i];
+      g << (i ? ", " : "") << "'sweep.csv' skip 1 using 11:" << sel << " with linespoints lw 2 pt 7 title '" << name
+        << "', '' skip 1 using 11:" << sel << ":1 with labels offset 0,1 notitle";
+    }
+    g << "\nset output\n";
+    run_gnuplot(dir, g.str(), {"sweep_error_time.png"}, w);
+  }
+  json j;
+  j["lpshoot_version"] = "0.1.0";
+  j["command"] = "sweep";
+  j["status"] = sw.all_converged ? "converged" : "not_converged";
+  j["message"] = sw.message;
+  j["problem"] = sw.problem;
+  j["reference"] = sw.reference;
+  j["error_columns"] = sw.error_columns;
+  j["runs"] = json::array();
+  for (const auto& r : sw.runs) {
+    json x;
+    x["N"] = r.N;
+    x["h"] = r.h;
+    if (!r.method.empty()) x["method"] = r.method, x["backend"] = r.backend, x["segments"] = r.segments;
+    x["status"] = r.status;
+    x["converged"] = r.converged;
+    if (!r.converged) x["message"] = r.message;
+    x["error"] = finite_or_null(r.error);
+    x["order"] = finite_or_null(r.order);
+    x["cost"] = finite_or_null(r.cost);
+    x["cost_error"] = finite_or_null(r.cost_error);
+    x["wall_time_s"] = r.wall_time_s;
+    x["iterations"] = r.iterations;
+    x["momentum_drift"] = r.momentum_drift;
+    j["runs"].push_back(x);
+  }
+  w.files.insert(w.files.begin(), (dir / "sweep.json").string());
+  j["files"] = w.files;
+  j["warnings"] = w.warnings;
+  j["scene"] = json::parse(scene.effective_json);
+  write_atomic(dir, "sweep.json", j.dump(2) + "\n");
+  return w;
+}
+
+}  // namespace lpshoot::app

@@ -1,0 +1,85 @@
+// One run of a scene (solve or simulate) as plain values: what report.json, trajectory.csv and
+// the plots are written from, and what `sweep` compares across grids.
+#pragma once
+
+#include "scene.hpp"
+
+#include <cmath>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace lpshoot::app {
+
+// Named columns of equal length; NaN marks "no value at this node" (written as an empty cell).
+struct Table {
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> columns;
+  void add(std::string name, std::vector<double> values) {
+    names.push_back(std::move(name));
+    columns.push_back(std::move(values));
+  }
+  size_t rows() const { return columns.empty() ? 0 : columns.front().size(); }
+  int index(const std::string& name) const {
+    for (size_t i = 0; i < names.size(); ++i)
+      if (names[i] == name) return static_cast<int>(i);
+    return -1;
+  }
+};
+
+struct RunRecord {
+  std::string command;  // "solve" or "simulate"
+  bool converged = false;
+  std::string status, message;
+  std::string problem;
+  int N = 0;
+  double T = 0, h = 0;
+  std::string method, backend, closure, constraints;  // empty when not applicable
+  int segments = 1;
+  double tolerance = 0;
+  bool has_cost = false;  // optimal control: ½ Σ h |u_n|^2
+  double cost = 0;
+  double action = 0;      // Σ L_d over the windows (the cost, for optimal control)
+  int iterations = 0;     // shooting iterations, or Newton iterations over all steps (simulate)
+  double residual_norm = 0, raw_residual_norm = 0, condition = 0;
+  int rank = 0, unknowns = 0;
+  std::vector<double> residual_history;
+  std::vector<std::string> dependent_conditions;
+  bool has_momentum = false;        // false when the symmetry group is trivial
+  double momentum_drift = 0;        // max_n |J_n - J_0| (max-norm)
+  double momentum_drift_relative = 0;
+  std::vector<double> momentum_initial;
+  double wall_time_s = 0;
+  std::vector<std::pair<std::string, double>> final_state;
+  Table trajectory;                        // first column t
+  Table momentum;                          // t, J1.., drift (when has_momentum)
+  std::vector<std::string> state_columns;  // the columns `sweep` measures errors on
+};
+
+// Progress lines for a terminal (the library never prints; the CLI decides where they go).
+using Progress = std::function<void(const std::string&)>;
+
+RunRecord solve_electron(const Scene& s, const Progress& progress);
+RunRecord solve_beanie(const Scene& s, const Progress& progress);
+RunRecord simulate_beanie_free(const Scene& s, const Progress& progress);
+
+// Why the scene's boundary value problem is ill-posed by counting (METHOD.md §5), or "".
+std::string check_boundary(const Scene& s);
+
+// Dispatch by problem; throws SceneError when the command does not fit the problem.
+RunRecord run_scene(const std::string& command, const Scene& s, const Progress& progress);
+
+// The exact continuous answer at the given times, where the problem has one (the electron with
+// all boundary data given): columns t, x1, x2, x3 and the exact cost. Empty otherwise.
+struct ExactReference {
+  bool available = false;
+  Table table;
+  double cost = 0;
+};
+ExactReference exact_reference(const Scene& s, const std::vector<double>& times);
+
+// Shared helpers for the runners.
+inline double nan() { return std::nan(""); }
+
+}  // namespace lpshoot::app

@@ -1,0 +1,49 @@
+// `solve` for the beanie optimal-control scene (METHOD.md §6.2).
+#include "run_common.hpp"
+
+namespace lpshoot::app {
+
+RunRecord solve_beanie(const Scene& s, const Progress& progress) {
+  using problems::BeanieControl;
+  RunRecord r = start_record("solve", s);
+  describe_solver(s, r);
+  r.constraints = constraints_name(s.constraints);
+  BeanieControl b;
+  b.par = s.beanie;
+  b.variant = s.constraints;
+  BoundaryValueProblem<BeanieControl> bvp{b, s.N, s.T, {}};
+  try {
+    bvp = problems::beanie_bvp(b, s.T, s.N, s.beanie_start, s.beanie_end, s.closure);
+  } catch (const std::invalid_argument& e) {
+    throw SceneError(s.file + ": boundary: " + e.what());
+  }
+  const auto res = solve_bvp(bvp, problems::beanie_guess(bvp, s.beanie_start, s.beanie_end),
+                             options_with_progress(s, progress));
+  record_outcome(res, r);
+  const Trajectory<BeanieControl>& tr = res.trajectory;
+  if (tr.N() != s.N) return r;
+
+  beanie_state_columns(tr, res.g, r.trajectory);
+  std::vector<double> u(s.N + 1, nan());
+  std::vector<std::vector<double>> lam(3, std::vector<double>(s.N + 1, nan()));
+  for (int n = 0; n + BeanieControl::order <= s.N; ++n) u[n] = b.control(tr.window_at(n), tr.h);
+  for (size_t n = 0; n < tr.lam.size(); ++n)
+    for (int i = 0; i < 3; ++i) lam[i][n] = tr.lam[n](i);
+  r.trajectory.add("u", u);
+  for (int i = 0; i < 3; ++i) r.trajectory.add("lambda" + std::to_string(i + 1), lam[i]);
+  r.state_columns = {"psi", "theta", "x", "y"};
+
+  const int N = s.N;
+  r.final_state = {{"psi", tr.p[N](0)},
+                   {"psi_dot", -end_velocity(tr.p[N](0), tr.p[N - 1](0), tr.p[N - 2](0), tr.h, s.closure)},
+                   {"theta", res.g[N].angle},
+                   {"x", res.g[N].t(0)},
+                   {"y", res.g[N].t(1)},
+                   {"Omega1", tr.g[N - 1].t(0) / tr.h},
+                   {"Omega2", tr.g[N - 1].t(1) / tr.h},
+                   {"Omega3", tr.g[N - 1].angle / tr.h}};
+  record_momentum(b, tr, res.g[0], r);
+  return r;
+}
+
+}  // namespace lpshoot::app

@@ -1,0 +1,112 @@
+// What the optimal-control runners share: the scene's solver settings into a RunRecord and the
+// shooting outcome into it (included by run_electron.cpp and run_beanie.cpp only).
+#pragma once
+
+#include "run.hpp"
+
+namespace lpshoot::app {
+
+inline RunRecord start_record(const std::string& command, const Scene& s) {
+  RunRecord r;
+  r.command = command;
+  r.problem = s.problem_name;
+  r.N = s.N;
+  r.T = s.T;
+  r.h = s.h();
+  return r;
+}
+
+inline void describe_solver(const Scene& s, RunRecord& r) {
+  r.method = method_name(s.shooting.method);
+  r.backend = backend_name(s.shooting.solver.backend);
+  r.closure = closure_name(s.closure);
+  r.segments = s.shooting.method == ShootingMethod::Multiple ? s.shooting.segments : 1;
+  r.tolerance = s.shooting.solver.tolerance;
+}
+
+// Shooting options with a progress line per iteration.
+inline ShootingOptions options_with_progress(const Scene& s, const Progress& progress) {
+  ShootingOptions opt = s.shooting;
+  if (progress)
+    opt.solver.on_iteration = [progress](int it, double norm) {
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "iteration %d: residual %.3g x tolerance", it, norm);
+      progress(buf);
+    };
+  return opt;
+}
+
+template <class P>
+void record_outcome(const ShootingResult<P>& res, RunRecord& r) {
+  r.converged = res.ok();
+  r.status = status_name(res.status);
+  r.message = res.ok() ? "converged in " + std::to_string(res.iterations) + " iterations" : res.message;
+  r.iterations = res.iterations;
+  r.residual_norm = res.residual_norm;
+  r.raw_residual_norm = res.raw_residual_norm;
+  r.condition = res.condition;
+  r.rank = res.rank;
+  r.unknowns = res.unknowns;
+  r.residual_history = res.residual_history;
+  r.dependent_conditions = res.dependent_conditions;
+  r.wall_time_s = res.wall_time_s;
+  r.has_cost = true;
+  r.cost = r.action = res.cost;
+}
+
+// x'(t) at an end from the nodes, with the closure's own stencil.
+inline double end_velocity(double p0, double p1, double p2, double h, Closure c) {
+  return c == Closure::Paper ? (p1 - p0) / h : (-3 * p0 + 4 * p1 - p2) / (2 * h);
+}
+
+// J_n, |J_n - J_0| over n = k-1 .. N-k into the record.
+template <class P>
+void record_momentum(const P& problem, const Trajectory<P>& tr, const GroupElement<P, double>& g0, RunRecord& r) {
+  const auto J = spatial_momentum(problem, tr, g0);
+  if (J.empty()) return;
+  r.has_momentum = true;
+  constexpr int k = P::order, d = P::Group::dim;
+  std::vector<double> t, drift;
+  std::vector<std::vector<double>> comp(d);
+  for (size_t i = 0; i < J.size(); ++i) {
+    t.push_back(tr.time(static_cast<int>(i) + k - 1));
+    for (int a = 0; a < d; ++a) comp[a].push_back(J[i](a));
+    const double e = (J[i] - J.front()).template lpNorm<Eigen::Infinity>();
+    drift.push_back(e);
+    r.momentum_drift = std::max(r.momentum_drift, e);
+  }
+  r.momentum_drift_relative = r.momentum_drift / std::max(1.0, J.front().template lpNorm<Eigen::Infinity>());
+  r.momentum_initial.assign(J.front().data(), J.front().data() + d);
+  r.momentum.add("t", t);
+  for (int a = 0; a < d; ++a) r.momentum.add("J" + std::to_string(a + 1), comp[a]);
+  r.momentum.add("drift", drift);
+}
+
+// Columns shared by the control and free beanie: t, psi, theta, x, y (nodes 0..N) and
+// Omega1..3 = g~_n / h (n = 0..N-1; the last row empty).
+template <class P>
+void beanie_state_columns(const Trajectory<P>& tr, const std::vector<SE2::Element<double>>& g, Table& out) {
+  const int N = tr.N();
+  std::vector<double> t, psi, theta, x, y;
+  std::vector<std::vector<double>> Omega(3, std::vector<double>(N + 1, nan()));
+  for (int n = 0; n <= N; ++n) {
+    t.push_back(tr.time(n));
+    psi.push_back(tr.p[n](0));
+    theta.push_back(g[n].angle);
+    x.push_back(g[n].t(0));
+    y.push_back(g[n].t(1));
+    if (n < N) {
+      Omega[0][n] = tr.g[n].t(0) / tr.h;
+      Omega[1][n] = tr.g[n].t(1) / tr.h;
+      Omega[2][n] = tr.g[n].angle / tr.h;
+    }
+  }
+  out.add("t", t);
+  out.add("psi", psi);
+  out.add("theta", theta);
+  out.add("x", x);
+  out.add("y", y);
+  for (int i = 0; i < 3; ++i) out.add("Omega" + std::to_string(i + 1), Omega[i]);
+}
+
+}  // namespace lpshoot::app

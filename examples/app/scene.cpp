@@ -1,0 +1,394 @@
+// Scene parsing and validation (nlohmann-json stays in this file and in report.cpp).
+#include "scene.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace lpshoot::app {
+namespace {
+
+using json = nlohmann::json;
+
+size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diag = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (std::tolower(a[i - 1]) == std::tolower(b[j - 1]) ? 0 : 1)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
+}
+
+std::string join(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+  return s;
+}
+
+// A JSON object at a key path; every accessor checks type, size and finiteness and names the key.
+class Reader {
+ public:
+  Reader(const json& j, std::string path, const std::string& file) : j_(j), path_(std::move(path)), file_(file) {
+    if (!j_.is_object()) fail(path_.empty() ? "the scene must be a JSON object" : "must be an object");
+  }
+
+  [[noreturn]] void fail(const std::string& what, const std::string& key = "") const {
+    const std::string at = key.empty() ? path_ : name(key);
+    throw SceneError(file_ + ": " + (at.empty() ? "" : at + ": ") + what);
+  }
+  std::string name(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+
+  // Rejects keys outside `allowed`, suggesting the nearest allowed one.
+  void allow(const std::vector<std::string>& allowed) const {
+    for (auto it = j_.begin(); it != j_.end(); ++it) {
+      if (std::find(allowed.begin(), allowed.end(), it.key()) != allowed.end()) continue;
+      std::string best;
+      size_t best_d = SIZE_MAX;
+      for (const auto& a : allowed)
+        if (const size_t d = edit_distance(it.key(), a); d < best_d) best_d = d, best = a;
+      const std::string hint = best_d <= std::max<size_t>(2, best.size() / 3)
+                                   ? "did you mean '" + name(best) + "'?"
+                                   : "allowed here: " + join(allowed);
+      fail("unknown key (" + hint + ")", it.key());
+    }
+  }
+  bool has(const std::string& key) const { return j_.contains(key) && !j_.at(key).is_null(); }
+  void forbid(const std::string& key, const std::string& why) const {
+    if (j_.contains(key)) fail(why, key);
+  }
+  const json& at(const std::string& key) const {
+    if (!has(key)) fail("missing (required)", key);
+    return j_.at(key);
+  }
+
+  double number(const std::string& key) const {
+    const json& v = at(key);
+    if (!v.is_number()) fail("must be a number, got " + std::string(v.type_name()), key);
+    const double x = v.get<double>();
+    if (!std::isfinite(x)) fail("must be finite", key);
+    return x;
+  }
+  double number(const std::string& key, double fallback) const { return has(key) ? number(key) : fallback; }
+  std::optional<double> optional_number(const std::string& key) const {
+    return has(key) ? std::optional<double>(number(key)) : std::nullopt;
+  }
+  double positive(const std::string& key, double fallback) const {
+    const double x = number(key, fallback);
+    if (!(x > 0)) fail("must be > 0 (got " + format(x) + ")", key);
+    return x;
+  }
+  int integer(const std::string& key, int fallback) const {
+    if (!has(key)) return fallback;
+    const json& v = at(key);
+    if (!v.is_number_integer() && !(v.is_number_float() && std::floor(v.get<double>()) == v.get<double>()))
+      fail("must be an integer, got " + v.dump(), key);
+    const double x = v.get<double>();
+    if (std::abs(x) > 1e9) fail("is out of range (" + v.dump() + ")", key);
+    return static_cast<int>(x);
+  }
+  bool boolean(const std::string& key, bool fallback) const {
+    if (!has(key)) return fallback;
+    if (!at(key).is_boolean()) fail("must be true or false, got " + at(key).dump(), key);
+    return at(key).get<bool>();
+  }
+  std::string choice(const std::string& key, const std::vector<std::string>& options, const std::string& fallback) const {
+    if (!has(key)) return fallback;
+    const json& v = at(key);
+    if (!v.is_string() || std::find(options.begin(), options.end(), v.get<std::string>()) == options.end())
+      fail("must be one of " + join(options) + " (got " + v.dump() + ")", key);
+    return v.get<std::string>();
+  }
+  std::string string(const std::string& key, const std::string& fallback) const {
+    if (!has(key)) return fallback;
+    if (!at(key).is_string()) fail("must be a string, got " + at(key).dump(), key);
+    return at(key).get<std::string>();
+  }
+  template <int n>
+  Eigen::Matrix<double, n, 1> vector(const std::string& key) const {
+    return vector_of<n>(at(key), name(key));
+  }
+  template <int n>
+  Eigen::Matrix<double, n, 1> vector_of(const json& v, const std::string& where) const {
+    if (!v.is_array() || v.size() != static_cast<size_t>(n))
+      throw SceneError(file_ + ": " + where + ": must be an array of " + std::to_string(n) + " numbers (got " +
+                       v.dump() + ")");
+    Eigen::Matrix<double, n, 1> x;
+    for (int i = 0; i < n; ++i) {
+      if (!v[i].is_number() || !std::isfinite(v[i].get<double>()))
+        throw SceneError(file_ + ": " + where + "[" + std::to_string(i) + "]: must be a finite number (got " +
+                         v[i].dump() + ")");
+      x(i) = v[i].get<double>();
+    }
+    return x;
+  }
+  Reader object(const std::string& key) const { return Reader(at(key), name(key), file_); }
+  std::optional<Reader> optional_object(const std::string& key) const {
+    return has(key) ? std::optional<Reader>(object(key)) : std::nullopt;
+  }
+
+  static std::string format(double x) {
+    std::ostringstream s;
+    s << x;
+    return s.str();
+  }
+
+ private:
+  const json& j_;
+  std::string path_;
+  const std::string& file_;
+};
+
+// ---------------------------------------------------------------- --set overrides
+
+void apply_override(json& scene, const std::string& assignment) {
+  const size_t eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw SceneError("--set '" + assignment + "': expected key.path=value (e.g. horizon.N=400)");
+  const std::string path = assignment.substr(0, eq), text = assignment.substr(eq + 1);
+  json value;
+  try {
+    value = json::parse(text);
+  } catch (const json::parse_error&) {
+    value = text;  // a bare word: a string
+  }
+  std::vector<std::string> keys;
+  std::stringstream ss(path);
+  for (std::string k; std::getline(ss, k, '.');) {
+    if (k.empty()) throw SceneError("--set '" + assignment + "': empty component in the key path '" + path + "'");
+    keys.push_back(k);
+  }
+  json* node = &scene;
+  for (size_t i = 0; i < keys.size(); ++i) {
+    const std::string& k = keys[i];
+    const bool last = i + 1 == keys.size();
+    if (node->is_array()) {  // numeric component: an array element
+      size_t idx = 0;
+      try {
+        idx = std::stoul(k);
+      } catch (const std::exception&) {
+        throw SceneError("--set '" + assignment + "': '" + k + "' must be an index into the array at that point");
+      }
+      if (idx >= node->size())
+        throw SceneError("--set '" + assignment + "': index " + k + " is past the end of an array of " +
+                         std::to_string(node->size()));
+      node = &(*node)[idx];
+    } else {
+      if (node->is_null()) *node = json::object();
+      if (!node->is_object())
+        throw SceneError("--set '" + assignment + "': '" + keys[i - 1] + "' is not an object");
+      if (last && value.is_null()) {
+        node->erase(k);  // "null" makes the entry free / default
+        return;
+      }
+      node = &(*node)[k];
+    }
+    if (last) *node = value;
+  }
+}
+
+// ---------------------------------------------------------------- sections
+
+ShootingMethod read_method(const std::string& s) { return s == "multiple" ? ShootingMethod::Multiple : ShootingMethod::Single; }
+
+void read_solver(const Reader& r, Scene& s) {
+  if (s.problem == ProblemKind::BeanieFree) {  // a simulation: only the per-step Newton is tuned
+    r.allow({"tolerance", "max_iterations"});
+    s.shooting.step.step_tolerance = r.positive("tolerance", s.shooting.step.step_tolerance);
+    s.shooting.step.max_iterations = r.integer("max_iterations", s.shooting.step.max_iterations);
+    if (s.shooting.step.max_iterations < 1) r.fail("must be >= 1", "max_iterations");
+    return;
+  }
+  r.allow({"method", "segments", "backend", "tolerance", "max_iterations", "threads"});
+  s.shooting.method = read_method(r.choice("method", {"single", "multiple"}, "single"));
+  const int max_segments = s.N - 2 * s.order() + 1;
+  s.shooting.segments = r.integer("segments", s.shooting.method == ShootingMethod::Multiple ? std::min(4, max_segments) : 1);
+  if (s.shooting.segments < 1 || s.shooting.segments > max_segments)
+    r.fail("must be between 1 and N - 2k + 1 = " + std::to_string(max_segments) + " (got " +
+               std::to_string(s.shooting.segments) + ")",
+           "segments");
+  if (s.shooting.method == ShootingMethod::Single && r.has("segments") && s.shooting.segments != 1)
+    r.fail("is only used with method \"multiple\"", "segments");
+  s.shooting.solver.backend = r.choice("backend", {"kinsol", "nlopt"}, "kinsol") == "nlopt" ? Backend::Nlopt : Backend::Kinsol;
+  s.shooting.solver.tolerance = r.positive("tolerance", 1e-10);
+  s.shooting.solver.max_iterations = r.integer("max_iterations", 50);
+  if (s.shooting.solver.max_iterations < 1) r.fail("must be >= 1", "max_iterations");
+  s.shooting.threads = r.integer("threads", 0);
+  if (s.shooting.threads < 0) r.fail("must be >= 0 (0: one per core)", "threads");
+}
+
+void read_electron(const Reader& root, Scene& s) {
+  const Reader par = root.object("parameters");
+  par.allow({"m", "e_over_c", "B", "potential"});
+  s.electron.mass = par.positive("m", 1.0);
+  s.electron.e_over_c = par.number("e_over_c", 1.0);
+  s.electron.B = par.has("B") ? par.vector<3>("B") : Eigen::Vector3d(0, 0, 1);
+  s.electron.potential = par.number("potential", 1.0);
+  const Reader bd = root.object("boundary");
+  bd.allow({"initial", "final"});
+  for (const char* side : {"initial", "final"}) {
+    problems::ElectronBoundary& b = std::string(side) == "initial" ? s.electron_start : s.electron_end;
+    b.free_position = b.free_velocity = true;
+    const std::optional<Reader> e = bd.optional_object(side);
+    if (!e) continue;
+    e->allow({"position", "velocity"});
+    if (e->has("velocity") && !e->has("position"))
+      e->fail("a velocity without a position is not supported (give the position too, or neither)", "velocity");
+    if (e->has("position")) b.position = e->vector<3>("position"), b.free_position = false;
+    if (e->has("velocity")) b.velocity = e->vector<3>("velocity"), b.free_velocity = false;
+  }
+}
+
+void read_beanie_parameters(const Reader& root, Scene& s) {
+  const Reader par = root.object("parameters");
+  par.allow({"m", "I1", "I2", "potential"});
+  s.beanie.m = par.positive("m", 1.0);
+  s.beanie.I1 = par.positive("I1", 1.0);
+  s.beanie.I2 = par.positive("I2", 1.0);
+  s.beanie.amplitude = 0.0;
+  if (const auto pot = par.optional_object("potential")) {
+    pot->allow({"type", "amplitude"});
+    const std::string type = pot->choice("type", {"none", "cosine"}, "none");
+    if (type == "cosine") {
+      s.beanie.amplitude = pot->number("amplitude");
+    } else if (pot->has("amplitude")) {
+      pot->fail("is only used with type \"cosine\"", "amplitude");
+    }
+  }
+}
+
+void read_beanie(const Reader& root, Scene& s) {
+  read_beanie_parameters(root, s);
+  const Reader bd = root.object("boundary");
+  bd.allow({"initial", "final"});
+  for (const char* side : {"initial", "final"}) {
+    problems::BeanieBoundary& b = std::string(side) == "initial" ? s.beanie_start : s.beanie_end;
+    b = {};
+    const std::optional<Reader> e = bd.optional_object(side);
+    if (!e) continue;
+    e->allow({"psi", "psi_dot", "theta", "x", "y", "Omega1", "Omega2", "Omega3"});
+    if (e->has("psi_dot") && !e->has("psi")) e->fail("is given without psi (give psi too, or neither)", "psi_dot");
+    b.psi = e->optional_number("psi");
+    b.psi_dot = e->optional_number("psi_dot");
+    b.theta = e->optional_number("theta");
+    b.x = e->optional_number("x");
+    b.y = e->optional_number("y");
+    b.Omega1 = e->optional_number("Omega1");
+    b.Omega2 = e->optional_number("Omega2");
+    b.Omega3 = e->optional_number("Omega3");
+  }
+}
+
+void read_beanie_free(const Reader& root, Scene& s) {
+  read_beanie_parameters(root, s);
+  const Reader bd = root.object("boundary");
+  bd.allow({"initial", "final"});
+  bd.forbid("final", "a simulation (beanie_free) starts from initial data only; remove boundary.final");
+  const Reader init = bd.object("initial");
+  init.allow({"configurations", "position", "velocity"});
+  if (init.has("configurations")) {
+    if (init.has("position") || init.has("velocity"))
+      init.fail("give either configurations or position and velocity, not both", "configurations");
+    const json& c = init.at("configurations");
+    if (!c.is_array() || c.size() != 2)
+      init.fail("must be [[x, y, theta, psi], [x, y, theta, psi]] (q_0 and q_1)", "configurations");
+    s.beanie_free.configurations = std::array<Eigen::Vector4d, 2>{
+        init.vector_of<4>(c[0], init.name("configurations") + "[0]"),
+        init.vector_of<4>(c[1], init.name("configurations") + "[1]")};
+  } else {
+    s.beanie_free.position = init.vector<4>("position");
+    s.beanie_free.velocity = init.vector<4>("velocity");
+  }
+}
+
+}  // namespace
+
+Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
+  Scene s;
+  s.file = path;
+  std::ifstream in(path);
+  if (!in) throw SceneError(path + ": cannot open the scene file");
+  json j;
+  try {
+    j = json::parse(in);
+  } catch (const json::parse_error& e) {
+    std::string what = e.what();  // "[json.exception.parse_error.101] parse error at line 3, column 5: ..."
+    const size_t at = what.find("] ");
+    throw SceneError(path + ": invalid JSON: " + (at == std::string::npos ? what : what.substr(at + 2)));
+  }
+  for (const auto& o : overrides) apply_override(j, o);
+  s.effective_json = j.dump(2);
+
+  const Reader root(j, "", path);
+  root.allow({"problem", "description", "parameters", "horizon", "boundary", "scheme", "solver", "output"});
+  s.problem_name = root.choice("problem", {"electron", "beanie", "beanie_free"}, "");
+  if (s.problem_name.empty()) root.fail("missing (required): one of electron, beanie, beanie_free", "problem");
+  s.problem = s.problem_name == "electron" ? ProblemKind::Electron
+              : s.problem_name == "beanie" ? ProblemKind::Beanie
+                                           : ProblemKind::BeanieFree;
+  root.string("description", "");
+
+  const Reader hz = root.object("horizon");
+  hz.allow({"T", "N"});
+  s.T = hz.number("T");
+  if (!(s.T > 0)) hz.fail("must be > 0 (got " + Reader::format(s.T) + ")", "T");
+  if (!hz.has("N")) hz.fail("missing (required)", "N");
+  s.N = hz.integer("N", 0);
+  const int k = s.order();
+  if (s.N < 2 * k + 1)
+    hz.fail("must be at least 2k + 1 = " + std::to_string(2 * k + 1) + " for " + s.problem_name + " (order k = " +
+                std::to_string(k) + "; got " + std::to_string(s.N) + ")",
+            "N");
+
+  switch (s.problem) {
+    case ProblemKind::Electron: read_electron(root, s); break;
+    case ProblemKind::Beanie: read_beanie(root, s); break;
+    case ProblemKind::BeanieFree: read_beanie_free(root, s); break;
+  }
+
+  if (const auto sc = root.optional_object("scheme")) {
+    if (s.problem == ProblemKind::BeanieFree) {
+      sc->allow({});
+    } else {
+      sc->allow(s.problem == ProblemKind::Beanie ? std::vector<std::string>{"closure", "constraints"}
+                                                 : std::vector<std::string>{"closure"});
+      s.closure = sc->choice("closure", {"paper", "second_order"}, "second_order") == "paper" ? Closure::Paper
+                                                                                               : Closure::SecondOrder;
+      if (s.problem == ProblemKind::Beanie)
+        s.constraints = sc->choice("constraints", {"paper", "exact_rotation"}, "exact_rotation") == "paper"
+                            ? problems::BeanieConstraints::Paper
+                            : problems::BeanieConstraints::ExactRotation;
+    }
+  }
+  if (const auto so = root.optional_object("solver"))
+    read_solver(*so, s);
+  else
+    read_solver(Reader(json::object(), "solver", path), s);
+
+  const std::string stem = std::filesystem::path(path).stem().string();
+  s.out_dir = "lpshoot-out/" + stem;
+  if (const auto out = root.optional_object("output")) {
+    out->allow({"dir", "plot"});
+    s.out_dir = out->string("dir", s.out_dir);
+    if (s.out_dir.empty()) out->fail("must not be empty", "dir");
+    s.plot = out->boolean("plot", true);
+  }
+  return s;
+}
+
+const char* closure_name(Closure c) { return c == Closure::Paper ? "paper" : "second_order"; }
+const char* constraints_name(problems::BeanieConstraints c) {
+  return c == problems::BeanieConstraints::Paper ? "paper" : "exact_rotation";
+}
+const char* method_name(ShootingMethod m) { return m == ShootingMethod::Multiple ? "multiple" : "single"; }
+
+}  // namespace lpshoot::app

@@ -1,0 +1,64 @@
+// A scene: one problem instance read from a JSON file (README "Scene reference"), validated
+// into typed values. Every error names the offending key and the file.
+#pragma once
+
+#include <lpshoot/problems/beanie_bvp.hpp>
+#include <lpshoot/problems/electron_bvp.hpp>
+
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace lpshoot::app {
+
+// A scene that cannot be read or is invalid. what() is one line that names the file and key.
+struct SceneError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+enum class ProblemKind { Electron, Beanie, BeanieFree };
+
+// Free-motion beanie initial data: q_0, q_1 directly, or a position and velocity
+// (q_1 = q_0 + h q'(0), the paper's first-order closure).
+struct BeanieFreeInitial {
+  std::optional<std::array<Eigen::Vector4d, 2>> configurations;  // (x, y, θ, ψ) at nodes 0, 1
+  Eigen::Vector4d position = Eigen::Vector4d::Zero(), velocity = Eigen::Vector4d::Zero();
+};
+
+struct Scene {
+  std::string file;           // where it was read from (for messages)
+  std::string effective_json; // the scene after --set overrides and defaults, pretty-printed
+  ProblemKind problem = ProblemKind::Electron;
+  std::string problem_name;
+  double T = 1.0;
+  int N = 100;
+
+  Closure closure = Closure::SecondOrder;
+  problems::BeanieConstraints constraints = problems::BeanieConstraints::ExactRotation;
+  ShootingOptions shooting;
+
+  std::string out_dir;
+  bool plot = true;
+
+  problems::Electron electron;
+  problems::ElectronBoundary electron_start, electron_end;
+
+  problems::BeanieParameters beanie;
+  problems::BeanieBoundary beanie_start, beanie_end;
+  BeanieFreeInitial beanie_free;
+
+  int order() const { return problem == ProblemKind::BeanieFree ? 1 : 2; }
+  double h() const { return T / N; }
+  bool is_optimal_control() const { return problem != ProblemKind::BeanieFree; }
+};
+
+// Reads, applies the --set overrides ("key.path=value", value parsed as JSON when it is JSON,
+// else taken as a string; "null" removes the key), validates. Throws SceneError.
+Scene load_scene(const std::string& path, const std::vector<std::string>& overrides = {});
+
+const char* closure_name(Closure c);
+const char* constraints_name(problems::BeanieConstraints c);
+const char* method_name(ShootingMethod m);
+
+}  // namespace lpshoot::app

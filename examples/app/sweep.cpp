@@ -1,0 +1,138 @@
+#include "sweep.hpp"
+
+#include <algorithm>
+#include <cstdio>
+
+namespace lpshoot::app {
+namespace {
+
+// Value of column `c` of a uniform-grid table at time t (a node when it is one, else linear
+// interpolation between the neighbouring nodes).
+double value_at(const Table& ref, int c, double t) {
+  const std::vector<double>& ts = ref.columns[0];
+  const int n = static_cast<int>(ts.size()) - 1;
+  const double h = ts[n] / n;
+  const double s = t / h;
+  const int i = std::clamp(static_cast<int>(std::floor(s)), 0, n - 1);
+  const double w = std::clamp(s - i, 0.0, 1.0);
+  if (w < 1e-9) return ref.columns[c][i];
+  if (w > 1 - 1e-9) return ref.columns[c][i + 1];
+  return (1 - w) * ref.columns[c][i] + w * ref.columns[c][i + 1];
+}
+
+double max_error(const Table& run, const Table& ref, const std::vector<std::string>& cols) {
+  double e = 0;
+  for (const auto& name : cols) {
+    const int a = run.index(name), b = ref.index(name);
+    if (a < 0 || b < 0) continue;
+    for (size_t n = 0; n < run.rows(); ++n)
+      e = std::max(e, std::abs(run.columns[a][n] - value_at(ref, b, run.columns[0][n])));
+  }
+  return e;
+}
+
+}  // namespace
+
+SweepRecord run_sweep(const Scene& scene, const std::string& command, const SweepOptions& opt, const Progress& progress) {
+  SweepRecord rec;
+  rec.problem = scene.problem_name;
+  std::vector<int> grids = opt.N;
+  std::sort(grids.begin(), grids.end());
+  grids.erase(std::unique(grids.begin(), grids.end()), grids.end());
+  const int k = scene.order();
+  if (grids.empty()) throw SceneError("--N: give at least one grid (e.g. --N 50,100,200)");
+  if (grids.front() < 2 * k + 1)
+    throw SceneError("--N: every N must be at least 2k + 1 = " + std::to_string(2 * k + 1) + " for " +
+                     scene.problem_name + " (got " + std::to_string(grids.front()) + ")");
+  if (scene.problem == ProblemKind::BeanieFree && scene.beanie_free.configurations)
+    throw SceneError(scene.file + ": boundary.initial.configurations: q_0, q_1 belong to one grid; a sweep needs "
+                                  "initial data as position and velocity");
+  // Solvers (simulations have none to choose) in the outer loop, grids coarse to fine.
+  std::vector<std::pair<ShootingMethod, Backend>> solvers;
+  for (ShootingMethod m : opt.methods.empty() ? std::vector{scene.shooting.method} : opt.methods)
+    for (Backend b : opt.backends.empty() ? std::vector{scene.shooting.solver.backend} : opt.backends)
+      if (scene.is_optimal_control() || solvers.empty()) solvers.emplace_back(m, b);
+  std::vector<RunRecord> full;
+  for (const auto& [m, b] : solvers)
+    for (int N : grids) {
+      Scene s = scene;
+      s.N = N;
+      SweepRun sr;
+      sr.N = N;
+      sr.h = s.h();
+      std::string label = "N = " + std::to_string(N);
+      if (scene.is_optimal_control()) {
+        s.shooting.method = m;
+        s.shooting.solver.backend = b;
+        int segments = opt.steps_per_segment > 0 ? (N + opt.steps_per_segment - 1) / opt.steps_per_segment
+                                                 : scene.shooting.segments;
+        if (m == ShootingMethod::Multiple && scene.shooting.method == ShootingMethod::Single && opt.steps_per_segment <= 0)
+          segments = 4;  // the scene asked for single shooting: multiple shooting's default
+        s.shooting.segments = std::clamp(segments, 1, N - 2 * k + 1);
+        sr.method = method_name(m);
+        sr.backend = backend_name(b);
+        sr.segments = m == ShootingMethod::Multiple ? s.shooting.segments : 1;
+        label += ", " + sr.method + " shooting" +
+                 (m == ShootingMethod::Multiple ? " (" + std::to_string(sr.segments) + " segments)" : "") + ", " +
+                 sr.backend;
+      }
+      if (progress)
+        progress("[" + std::to_string(full.size() + 1) + "/" + std::to_string(solvers.size() * grids.size()) + "] " + label);
+      full.push_back(run_scene(command, s, Progress()));
+      const RunRecord& r = full.back();
+      sr.converged = r.converged;
+      sr.status = r.status;
+      sr.message = r.message;
+      sr.iterations = r.iterations;
+      sr.wall_time_s = r.wall_time_s;
+      sr.momentum_drift = r.momentum_drift;
+      if (r.has_cost) sr.cost = r.cost;
+      rec.runs.push_back(sr);
+      if (!r.converged && rec.all_converged) {
+        rec.all_converged = false;
+        rec.message = label + ": " + r.status + ": " + r.message;
+      }
+    }
+
+  // Reference: the exact oracle, else the finest grid of the first solver.
+  for (const auto& r : full)
+    if (!r.state_columns.empty()) rec.error_columns = r.state_columns;
+  Table ref;
+  double ref_cost = nan();
+  size_t ref_index = SIZE_MAX;
+  const ExactReference exact = opt.use_exact ? exact_reference(scene, {}) : ExactReference{};
+  if (exact.available) {
+    rec.reference = "exact continuous optimum (matrix exponential)";
+    ref_cost = exact.cost;
+  } else {
+    ref_index = grids.size() - 1;  // the first solver's finest run
+    rec.reference = "finest grid (N = " + std::to_string(grids.back()) + ", " +
+                    (rec.runs[ref_index].method.empty() ? std::string("discrete flow")
+                                                        : rec.runs[ref_index].method + " shooting, " + rec.runs[ref_index].backend) +
+                    ")";
+    if (full[ref_index].converged) {
+      ref = full[ref_index].trajectory;
+      ref_cost = full[ref_index].has_cost ? full[ref_index].cost : nan();
+    }
+  }
+  for (size_t i = 0; i < full.size(); ++i) {
+    SweepRun& sr = rec.runs[i];
+    if (!full[i].converged || i == ref_index) continue;
+    if (exact.available) {
+      const ExactReference at = exact_reference(scene, full[i].trajectory.columns[0]);
+      sr.error = max_error(full[i].trajectory, at.table, rec.error_columns);
+    } else if (ref.rows() > 0) {
+      sr.error = max_error(full[i].trajectory, ref, rec.error_columns);
+    }
+    if (full[i].has_cost && std::isfinite(ref_cost)) sr.cost_error = std::abs(full[i].cost - ref_cost);
+  }
+  // Observed orders between consecutive grids of the same solver.
+  for (size_t i = 1; i < rec.runs.size(); ++i) {
+    SweepRun &a = rec.runs[i - 1], &b = rec.runs[i];
+    if (a.method == b.method && a.backend == b.backend && a.N < b.N && a.error > 0 && b.error > 0)
+      b.order = std::log(a.error / b.error) / std::log(double(b.N) / a.N);
+  }
+  return rec;
+}
+
+}  // namespace lpshoot::app
