@@ -160,6 +160,8 @@ void apply_override(json& scene, const std::string& assignment) {
     value = json::parse(text);
   } catch (const json::parse_error&) {
     value = text;  // a bare word: a string
+  } catch (const json::exception& e) {
+    throw SceneError("--set '" + assignment + "': the value cannot be read (" + e.what() + ")");
   }
   std::vector<std::string> keys;
   std::stringstream ss(path);
@@ -216,8 +218,7 @@ void read_solver(const Reader& r, Scene& s) {
     r.fail("must be between 1 and N - 2k + 1 = " + std::to_string(max_segments) + " (got " +
                std::to_string(s.shooting.segments) + ")",
            "segments");
-  if (s.shooting.method == ShootingMethod::Single && r.has("segments") && s.shooting.segments != 1)
-    r.fail("is only used with method \"multiple\"", "segments");
+  if (s.shooting.method == ShootingMethod::Single) s.shooting.segments = 1;  // segments: multiple shooting only
   s.shooting.solver.backend = r.choice("backend", {"kinsol", "nlopt"}, "kinsol") == "nlopt" ? Backend::Nlopt : Backend::Kinsol;
   s.shooting.solver.tolerance = r.positive("tolerance", 1e-10);
   s.shooting.solver.max_iterations = r.integer("max_iterations", 50);
@@ -320,7 +321,7 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
   json j;
   try {
     j = json::parse(in);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse errors, and numbers out of range (1e999)
     std::string what = e.what();  // "[json.exception.parse_error.101] parse error at line 3, column 5: ..."
     const size_t at = what.find("] ");
     throw SceneError(path + ": invalid JSON: " + (at == std::string::npos ? what : what.substr(at + 2)));

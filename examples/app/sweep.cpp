@@ -129,7 +129,9 @@ SweepRecord run_sweep(const Scene& scene, const std::string& command, const Swee
   // Observed orders between consecutive grids of the same solver.
   for (size_t i = 1; i < rec.runs.size(); ++i) {
     SweepRun &a = rec.runs[i - 1], &b = rec.runs[i];
-    if (a.method == b.method && a.backend == b.backend && a.N < b.N && a.error > 0 && b.error > 0)
+    // On the reference grid itself the error measures the solvers' disagreement, not the scheme.
+    const bool on_reference_grid = !exact.available && b.N == grids.back();
+    if (a.method == b.method && a.backend == b.backend && a.N < b.N && a.error > 0 && b.error > 0 && !on_reference_grid)
       b.order = std::log(a.error / b.error) / std::log(double(b.N) / a.N);
   }
   return rec;

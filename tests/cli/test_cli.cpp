@@ -1,0 +1,338 @@
+// The lpshoot application end to end: the example scenes against their stored answers and
+// against the exact electron optimum, sweeps and their observed orders, failed runs that say so,
+// and one test per class of bad input (clean message naming the key, exit code 2, no output).
+#include <lpshoot/problems/electron_exact.hpp>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+namespace {
+
+struct Outcome {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+fs::path scratch(const std::string& name) {
+  const fs::path d = fs::path(::testing::TempDir()) / ("lpshoot_cli_" + name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+// Runs `lpshoot ARGS` with stdout and stderr captured.
+Outcome run_cli(const std::string& args, const fs::path& work) {
+  const std::string cmd = std::string("'") + LPSHOOT_CLI + "' " + args + " > '" + (work / "stdout").string() + "' 2> '" +
+                          (work / "stderr").string() + "'";
+  const int rc = std::system(cmd.c_str());
+  return {rc == -1 ? -1 : WEXITSTATUS(rc), slurp(work / "stdout"), slurp(work / "stderr")};
+}
+
+std::string scene(const std::string& name) { return std::string(LPSHOOT_SCENES) + "/" + name + ".json"; }
+
+const json* at_path(const json& j, const std::string& dotted) {
+  const json* node = &j;
+  std::stringstream ss(dotted);
+  for (std::string k; std::getline(ss, k, '.');) {
+    if (!node->is_object() || !node->contains(k)) return nullptr;
+    node = &(*node)[k];
+  }
+  return node;
+}
+
+bool gnuplot_available() { return std::system("command -v gnuplot > /dev/null 2>&1") == 0; }
+
+bool is_png(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  char magic[8] = {};
+  f.read(magic, 8);
+  return f && std::string(magic + 1, 3) == "PNG";
+}
+
+// Rows of a CSV with a header; empty cells are NaN.
+std::vector<std::vector<double>> read_csv(const fs::path& p, std::vector<std::string>& header) {
+  std::ifstream f(p);
+  std::string line;
+  std::getline(f, line);
+  header.clear();
+  std::stringstream hs(line);
+  for (std::string c; std::getline(hs, c, ',');) header.push_back(c);
+  std::vector<std::vector<double>> rows;
+  while (std::getline(f, line)) {
+    std::vector<double> row;
+    std::stringstream ls(line);
+    std::string c;
+    for (size_t i = 0; i < header.size(); ++i) {
+      std::getline(ls, c, ',');
+      row.push_back(c.empty() ? std::nan("") : std::stod(c));
+    }
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+// Runs an example scene and compares its report with examples/scenes/expected/NAME.json.
+json run_example(const std::string& name, const fs::path& out) {
+  const json expected = json::parse(std::ifstream(std::string(LPSHOOT_SCENES) + "/expected/" + name + ".json"));
+  const Outcome o = run_cli(expected["command"].get<std::string>() + " '" + scene(name) + "' --out '" + out.string() + "'", out.parent_path());
+  EXPECT_EQ(o.code, 0) << o.out << o.err;
+  const json report = json::parse(std::ifstream(out / "report.json"));
+  EXPECT_EQ(report["status"], expected["status"]);
+  for (const auto& [key, vt] : expected["values"].items()) {
+    const json* v = at_path(report, key);
+    if (!v || !v->is_number()) {
+      ADD_FAILURE() << name << ": report.json has no number at " << key;
+      continue;
+    }
+    EXPECT_NEAR(v->get<double>(), vt[0].get<double>(), vt[1].get<double>()) << name << ": " << key;
+  }
+  for (const auto& [key, bound] : expected["max"].items()) {
+    const json* v = at_path(report, key);
+    if (!v || !v->is_number()) {
+      ADD_FAILURE() << name << ": report.json has no number at " << key;
+      continue;
+    }
+    EXPECT_LE(v->get<double>(), bound.get<double>()) << name << ": " << key;
+  }
+  // Trajectory: header starting with t, N + 1 rows, every state value finite.
+  std::vector<std::string> header;
+  const auto rows = read_csv(out / "trajectory.csv", header);
+  EXPECT_EQ(header.front(), "t");
+  EXPECT_EQ(rows.size(), report["N"].get<size_t>() + 1);
+  for (const auto& r : rows) EXPECT_TRUE(std::isfinite(r[1])) << name << ": " << header[1] << " is not finite";
+  if (gnuplot_available()) {
+    EXPECT_TRUE(is_png(out / "trajectory.png")) << o.err;
+  }
+  return report;
+}
+
+}  // namespace
+
+TEST(ExampleScenes, Electron) {
+  const fs::path out = scratch("electron") / "out";
+  const json report = run_example("electron", out);
+  // Independent of the stored answer: the discrete optimum is within its second-order error of
+  // the exact continuous optimum (3.2e-5 at h = 0.01, see the sweep test), the discrete cost
+  // within its first-order quadrature error.
+  std::vector<std::string> header;
+  const auto rows = read_csv(out / "trajectory.csv", header);
+  lpshoot::problems::Electron e;
+  const auto exact = lpshoot::problems::electron_exact_optimum(e, 2.0, {1.0, 0.0, 0.5}, {0.0, 1.0, 0.0}, {0.0, 1.0, -0.5},
+                                                               {-1.0, 0.0, 0.2});
+  double err = 0;
+  for (const auto& r : rows) err = std::max(err, (Eigen::Vector3d(r[1], r[2], r[3]) - exact.position(r[0])).lpNorm<Eigen::Infinity>());
+  EXPECT_LT(err, 5e-5);
+  EXPECT_GT(err, 1e-6);  // and it is a discretization error, not a copy of the oracle
+  EXPECT_NEAR(report["cost"].get<double>(), exact.cost, 5e-3);
+  EXPECT_EQ(header, (std::vector<std::string>{"t", "x1", "x2", "x3", "u1", "u2", "u3"}));
+}
+
+TEST(ExampleScenes, Beanie) {
+  const fs::path out = scratch("beanie") / "out";
+  const json report = run_example("beanie", out);
+  std::vector<std::string> header;
+  read_csv(out / "trajectory.csv", header);
+  EXPECT_EQ(header, (std::vector<std::string>{"t", "psi", "theta", "x", "y", "Omega1", "Omega2", "Omega3", "u", "lambda1",
+                                              "lambda2", "lambda3"}));
+  EXPECT_EQ(report["rank"], report["unknowns"]);
+  if (gnuplot_available()) {
+    EXPECT_TRUE(is_png(out / "momentum.png"));
+  }
+}
+
+TEST(ExampleScenes, BeanieFree) {
+  const fs::path out = scratch("beanie_free") / "out";
+  run_example("beanie_free", out);
+  std::vector<std::string> header;
+  const auto rows = read_csv(out / "trajectory.csv", header);
+  EXPECT_EQ(header, (std::vector<std::string>{"t", "psi", "theta", "x", "y", "Omega1", "Omega2", "Omega3"}));
+  // Free motion: Ω3 is conserved by the exact discrete equations (METHOD.md §6.2).
+  for (size_t n = 0; n + 1 < rows.size(); ++n) EXPECT_NEAR(rows[n][7], rows[0][7], 1e-12);
+}
+
+TEST(ExampleScenes, UnstableElectronMultipleShooting) {
+  run_example("electron_unstable", scratch("electron_unstable") / "out");
+}
+
+TEST(FailedRuns, SingleShootingOnTheUnstableElectronFailsAndSaysSo) {
+  const fs::path work = scratch("unstable_single"), out = work / "out";
+  ASSERT_EQ(run_cli("solve '" + scene("electron_unstable") + "' --no-plot --out '" + out.string() + "'", work).code, 0);
+  ASSERT_TRUE(fs::exists(out / "trajectory.csv"));
+  const Outcome o = run_cli("solve '" + scene("electron_unstable") + "' --set solver.method=single --out '" + out.string() + "'", work);
+  EXPECT_EQ(o.code, 1);
+  EXPECT_NE(o.err.find("not_converged"), std::string::npos) << o.err;
+  const json report = json::parse(std::ifstream(out / "report.json"));
+  EXPECT_EQ(report["converged"], false);
+  EXPECT_EQ(report["status"], "not_converged");
+  EXPECT_FALSE(report["message"].get<std::string>().empty());
+  EXPECT_FALSE(fs::exists(out / "trajectory.csv")) << "the previous run's trajectory must not survive a failed run";
+  EXPECT_EQ(o.out.find("nan"), std::string::npos);
+}
+
+TEST(FailedRuns, RedundantBoundaryDataAreReportedAsRankDeficient) {
+  // θ(T) and Ω3(T) both given: Ω3 is conserved and θ(T) already fixes it (METHOD.md §5).
+  const fs::path work = scratch("redundant");
+  const Outcome o = run_cli("solve '" + scene("beanie") + "' --no-plot --set boundary.final.Omega3=0.5 --out '" +
+                                (work / "out").string() + "'", work);
+  EXPECT_EQ(o.code, 1);
+  const json report = json::parse(std::ifstream(work / "out" / "report.json"));
+  EXPECT_EQ(report["status"], "rank_deficient");
+  EXPECT_EQ(report["rank"].get<int>() + 1, report["unknowns"].get<int>());
+  EXPECT_NE(report["message"].get<std::string>().find("terminal Omega3"), std::string::npos) << report["message"];
+}
+
+TEST(Sweep, ElectronOrdersAgainstTheExactOptimum) {
+  const fs::path work = scratch("sweep_electron");
+  for (const std::string closure : {"second_order", "paper"}) {
+    const Outcome o = run_cli("sweep '" + scene("electron") + "' --N 50,100,200,400 --steps-per-segment 25 --set scheme.closure=" +
+                                  closure + " --out '" + (work / closure).string() + "'", work);
+    ASSERT_EQ(o.code, 0) << o.out << o.err;
+    const json sw = json::parse(std::ifstream(work / closure / "sweep.json"));
+    EXPECT_EQ(sw["reference"].get<std::string>().rfind("exact", 0), 0u);
+    ASSERT_EQ(sw["runs"].size(), 4u);
+    const double expected = closure == "paper" ? 1.0 : 2.0;
+    for (size_t i = 1; i < 4; ++i) EXPECT_NEAR(sw["runs"][i]["order"].get<double>(), expected, 0.15) << closure << " run " << i;
+    EXPECT_TRUE(sw["runs"][0]["order"].is_null());
+    if (gnuplot_available()) {
+      EXPECT_TRUE(is_png(work / closure / "sweep_error_time.png"));
+    }
+  }
+}
+
+TEST(Sweep, SolversAgreeOnTheFinestGrid) {
+  const fs::path work = scratch("sweep_solvers");
+  const Outcome o = run_cli("sweep '" + scene("beanie") + "' --N 100,200 --method single,multiple --backend kinsol,nlopt --no-plot --out '" +
+                                (work / "out").string() + "'", work);
+  ASSERT_EQ(o.code, 0) << o.out << o.err;
+  const json sw = json::parse(std::ifstream(work / "out" / "sweep.json"));
+  ASSERT_EQ(sw["runs"].size(), 8u);
+  for (const auto& r : sw["runs"]) {
+    EXPECT_TRUE(r["converged"].get<bool>());
+    if (r["N"] == 200 && !r["error"].is_null()) {
+      EXPECT_LT(r["error"].get<double>(), 1e-6) << r.dump();  // against single/kinsol on the same grid
+    }
+    if (r["N"] == 100) {
+      EXPECT_GT(r["error"].get<double>(), 1e-5) << r.dump();  // a discretization error
+    }
+  }
+}
+
+TEST(Overrides, SetChangesTheSceneAndIsRecorded) {
+  const fs::path work = scratch("overrides");
+  const Outcome o = run_cli("solve '" + scene("electron") + "' --no-plot --set horizon.N=100 --set solver.segments=4 --set parameters.B.2=0.5 --out '" +
+                                (work / "out").string() + "'", work);
+  ASSERT_EQ(o.code, 0) << o.err;
+  const json report = json::parse(std::ifstream(work / "out" / "report.json"));
+  EXPECT_EQ(report["N"], 100);
+  EXPECT_DOUBLE_EQ(report["h"].get<double>(), 0.02);
+  EXPECT_EQ(report["segments"], 4);
+  EXPECT_DOUBLE_EQ(report["scene"]["parameters"]["B"][2].get<double>(), 0.5);
+  EXPECT_EQ(o.err.find("iteration"), std::string::npos) << "no progress expected when stderr is not a terminal";
+}
+
+TEST(Overrides, ProgressOnlyWhenAsked) {
+  const fs::path work = scratch("progress");
+  const Outcome quiet = run_cli("solve '" + scene("electron") + "' --no-plot --out '" + (work / "a").string() + "'", work);
+  EXPECT_EQ(quiet.err.find("iteration"), std::string::npos);
+  const Outcome loud = run_cli("solve '" + scene("electron") + "' --no-plot --progress --out '" + (work / "b").string() + "'", work);
+  EXPECT_NE(loud.err.find("iteration 1: residual"), std::string::npos) << loud.err;
+}
+
+// ---------------------------------------------------------------- bad input
+
+struct BadCase {
+  std::string name, args, message;
+  int code = 2;
+};
+
+class BadInput : public ::testing::Test {
+ protected:
+  void expect_clean_failure(const BadCase& c) {
+    const fs::path work = scratch("bad_" + c.name), out = work / "out";
+    std::string args = c.args;
+    for (size_t p; (p = args.find("OUT")) != std::string::npos;) args.replace(p, 3, out.string());
+    for (size_t p; (p = args.find("WORK")) != std::string::npos;) args.replace(p, 4, work.string());
+    const Outcome o = run_cli(args, work);
+    EXPECT_EQ(o.code, c.code) << c.name << ": " << o.err;
+    EXPECT_NE(o.err.find(c.message), std::string::npos) << c.name << ": stderr was: " << o.err;
+    EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << c.name << ": one line expected: " << o.err;
+    EXPECT_FALSE(fs::exists(out / "report.json")) << c.name;
+    EXPECT_EQ(o.err.find("terminate"), std::string::npos) << c.name;
+  }
+  static void write(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
+};
+
+TEST_F(BadInput, EachClassFailsCleanlyNamingTheKey) {
+  const std::string e = "'" + scene("electron") + "' --out OUT ", b = "'" + scene("beanie") + "' --out OUT ";
+  const std::vector<BadCase> cases = {
+      {"missing_file", "solve WORK/none.json --out OUT", "none.json: cannot open the scene file"},
+      {"unknown_key", "solve " + e + "--set horizon.NN=4", "horizon.NN: unknown key (did you mean 'horizon.N'?)"},
+      {"unknown_top_key", "solve " + e + "--set solvr.method=single", "solvr: unknown key (did you mean 'solver'?)"},
+      {"wrong_size", "solve " + e + "--set parameters.B=[1,2]", "parameters.B: must be an array of 3 numbers"},
+      {"wrong_type", "solve " + e + "--set horizon.N=\\\"many\\\"", "horizon.N: must be an integer"},
+      {"non_finite", "solve " + e + "--set parameters.B.0=1e999", "number overflow"},
+      {"small_N", "solve " + e + "--set horizon.N=4", "horizon.N: must be at least 2k + 1 = 5"},
+      {"non_positive_T", "solve " + e + "--set horizon.T=0", "horizon.T: must be > 0"},
+      {"bad_choice", "solve " + e + "--set solver.backend=ipopt", "solver.backend: must be one of kinsol, nlopt"},
+      {"segments", "solve " + e + "--set solver.segments=0", "solver.segments: must be between 1 and"},
+      {"tolerance", "solve " + e + "--set solver.tolerance=-1", "solver.tolerance: must be > 0"},
+      {"missing_required", "solve " + e + "--set horizon=null", "horizon: missing (required)"},
+      {"velocity_without_position", "solve " + e + "--set boundary.final.position=null",
+       "boundary.final.velocity: a velocity without a position"},
+      {"psi_dot_without_psi", "solve " + b + "--set boundary.final.psi=null", "boundary.final.psi_dot: is given without psi"},
+      {"amplitude_without_cosine", "solve " + b + "--set parameters.potential.type=none", "parameters.potential.amplitude"},
+      {"final_for_simulation", "simulate '" + scene("beanie_free") + "' --out OUT --set boundary.final.psi=1", "boundary.final"},
+      {"wrong_command", "simulate " + e, "run `lpshoot solve` on it"},
+      {"malformed_set", "solve " + e + "--set horizon.N", "--set 'horizon.N': expected key.path=value"},
+      {"sweep_small_N", "sweep " + e + "--N 3,50", "--N: every N must be at least 2k + 1 = 5"},
+      {"unwritable_out", "", "cannot create the output directory", 3},
+  };
+  for (const BadCase& c : cases) {
+    SCOPED_TRACE(c.name);
+    if (c.name == "unwritable_out") {  // the run happens; writing fails with exit code 3
+      const fs::path work = scratch("bad_" + c.name);
+      write(work / "file", "a file, not a directory");
+      const Outcome o = run_cli("solve '" + scene("electron") + "' --no-plot --out '" + (work / "file" / "sub").string() + "'", work);
+      EXPECT_EQ(o.code, 3) << o.err;
+      EXPECT_NE(o.err.find(c.message), std::string::npos) << o.err;
+      continue;
+    }
+    expect_clean_failure(c);
+  }
+}
+
+TEST_F(BadInput, InvalidJsonNamesTheLine) {
+  const fs::path work = scratch("bad_json");
+  write(work / "broken.json", "{\n  \"problem\": \"electron\",\n  \"horizon\": {\"T\": 1, \"N\": 10},\n}\n");
+  const Outcome o = run_cli("check '" + (work / "broken.json").string() + "'", work);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("broken.json: invalid JSON: parse error at line 4"), std::string::npos) << o.err;
+}
+
+TEST_F(BadInput, CheckAcceptsEveryExampleScene) {
+  const fs::path work = scratch("check");
+  for (const char* name : {"electron", "beanie", "beanie_free", "electron_unstable"}) {
+    const Outcome o = run_cli(std::string("check '") + scene(name) + "'", work);
+    EXPECT_EQ(o.code, 0) << name << ": " << o.err;
+    EXPECT_NE(o.out.find("valid"), std::string::npos);
+  }
+}
