@@ -35,6 +35,12 @@ std::string fmt(const char* f, double x) {
   return buf;
 }
 
+std::string join_numbers(const std::vector<double>& v) {
+  std::string s;
+  for (double x : v) s += (s.empty() ? "" : ", ") + fmt("%.6g", x);
+  return s;
+}
+
 void print_files(const Written& w) {
   for (const auto& warning : w.warnings) std::fprintf(stderr, "lpshoot: warning: %s\n", warning.c_str());
   std::printf("wrote:");
@@ -60,7 +66,11 @@ void print_run(const RunRecord& r) {
   if (r.has_cost) std::printf("cost: %.15g\n", r.cost);
   else std::printf("action: %.15g\n", r.action);
   if (r.has_momentum)
-    std::printf("momentum drift: max_n |J_n - J_0| = %.3e (relative %.3e)\n", r.momentum_drift, r.momentum_drift_relative);
+    std::printf("momentum drift: max_n |J_n - J_0| = %.3e (relative %.3e), J_0 = (%s)\n", r.momentum_drift,
+                r.momentum_drift_relative, join_numbers(r.momentum_initial).c_str());
+  if (r.has_physical_momentum)
+    std::printf("mechanical momentum drift: max_n |P_n - P_0| = %.3e, P_0 = (%s)\n", r.physical_momentum_drift,
+                join_numbers(r.physical_momentum_initial).c_str());
   std::printf("final:");
   for (const auto& [k, v] : r.final_state) std::printf(" %s = %.10g", k.c_str(), v);
   std::printf("\nwall time: %.3f s\n", r.wall_time_s);

@@ -147,12 +147,18 @@ std::string run_plot_script(const Scene& scene, const RunRecord& r, bool momentu
   if (momentum_plot) {
     s << gp_header("momentum.png", 800, 500) << "set title 'spatial momentum drift max_i |J_n - J_0|_i'\n"
       << "set xlabel 't'\nset ylabel ''\nset size noratio\n";
-    if (r.momentum_drift > 0)
+    const bool P = r.has_physical_momentum;
+    if (r.momentum_drift > 0 || (P && r.physical_momentum_drift > 0)) {
       s << "set logscale y\nset format y '10^{%L}'\n"
-        << "plot 'momentum.csv' using 't':(column('drift') > 0 ? column('drift') : NaN) with points pt 7 ps 0.4 "
-           "title '|J_n - J_0| (zeros not shown)'\n";
-    else
-      s << "set yrange [-1:1]\nplot 'momentum.csv' using 't':'drift' with lines lw 2 title '|J_n - J_0| (exactly 0)'\n";
+        << "plot 'momentum.csv' using 't':(column('J_drift') > 0 ? column('J_drift') : NaN) with points pt 7 ps 0.4 "
+           "title '" << (P ? "optimal-control momentum " : "") << "|J_n - J_0| (zeros not shown)'";
+      if (P)
+        s << ", '' using 't':(column('P_drift') > 0 ? column('P_drift') : NaN) with points pt 7 ps 0.4 "
+             "title 'mechanical momentum |P_n - P_0|'";
+      s << "\n";
+    } else {
+      s << "set yrange [-1:1]\nplot 'momentum.csv' using 't':'J_drift' with lines lw 2 title '|J_n - J_0| (exactly 0)'\n";
+    }
     s << "set output\n";
   }
   return s.str();
@@ -224,6 +230,10 @@ Written write_run(const Scene& scene, const RunRecord& r, const std::string& dir
     j["momentum_drift"] = r.momentum_drift;
     j["momentum_drift_relative"] = r.momentum_drift_relative;
     j["momentum_initial"] = r.momentum_initial;
+    if (r.has_physical_momentum) {
+      j["physical_momentum_drift"] = r.physical_momentum_drift;
+      j["physical_momentum_initial"] = r.physical_momentum_initial;
+    }
   } else {
     j["momentum_drift"] = r.converged && r.problem == "electron" ? json(0.0) : json(nullptr);
     j["momentum_note"] = r.problem == "electron" ? "the symmetry group is trivial: no momentum map to conserve"

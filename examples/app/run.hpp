@@ -50,10 +50,15 @@ struct RunRecord {
   double momentum_drift = 0;        // max_n |J_n - J_0| (max-norm)
   double momentum_drift_relative = 0;
   std::vector<double> momentum_initial;
+  // Optimal control: the mechanical system's own spatial momentum along the optimal motion (the
+  // free L_d's J, conserved when the constraints are its exact equations; columns P*).
+  bool has_physical_momentum = false;
+  double physical_momentum_drift = 0;
+  std::vector<double> physical_momentum_initial;
   double wall_time_s = 0;
   std::vector<std::pair<std::string, double>> final_state;
   Table trajectory;                        // first column t
-  Table momentum;                          // t, J1.., drift (when has_momentum)
+  Table momentum;                          // t, J1.., J_drift (, P1.., P_drift) when has_momentum
   std::vector<std::string> state_columns;  // the columns `sweep` measures errors on
 };
 

@@ -43,6 +43,16 @@ RunRecord solve_beanie(const Scene& s, const Progress& progress) {
                    {"Omega2", tr.g[N - 1].t(1) / tr.h},
                    {"Omega3", tr.g[N - 1].angle / tr.h}};
   record_momentum(b, tr, res.g[0], r);
+  // The beanie's physical momentum: the free L_d (76) along the same motion.
+  problems::BeanieFree free;
+  free.par = s.beanie;
+  Trajectory<problems::BeanieFree> motion;
+  motion.h = tr.h;
+  motion.p = tr.p;
+  motion.g = tr.g;
+  motion.lam.assign(tr.g.size(), Vec<double, 0>());
+  r.has_physical_momentum = true;
+  r.physical_momentum_drift = momentum_columns(free, motion, res.g[0], "P", r.momentum, &r.physical_momentum_initial, nullptr);
   return r;
 }
 

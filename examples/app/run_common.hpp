@@ -59,27 +59,40 @@ inline double end_velocity(double p0, double p1, double p2, double h, Closure c)
   return c == Closure::Paper ? (p1 - p0) / h : (-3 * p0 + 4 * p1 - p2) / (2 * h);
 }
 
-// J_n, |J_n - J_0| over n = k-1 .. N-k into the record.
+// Columns PREFIX1.., PREFIX_drift = |J_n - J_0| of the spatial momentum over the nodes 0..N
+// (defined for n = k-1 .. N-k; empty cells elsewhere) into `table`; returns the max drift, and
+// J_0 and the relative drift through the pointers.
+template <class P>
+double momentum_columns(const P& problem, const Trajectory<P>& tr, const GroupElement<P, double>& g0,
+                        const std::string& prefix, Table& table, std::vector<double>* J0, double* relative) {
+  const auto J = spatial_momentum(problem, tr, g0);
+  constexpr int k = P::order, d = P::Group::dim;
+  const int N = tr.N();
+  if (table.names.empty()) {
+    std::vector<double> t;
+    for (int n = 0; n <= N; ++n) t.push_back(tr.time(n));
+    table.add("t", t);
+  }
+  std::vector<std::vector<double>> comp(d, std::vector<double>(N + 1, nan()));
+  std::vector<double> drift(N + 1, nan());
+  double worst = 0;
+  for (size_t i = 0; i < J.size(); ++i) {
+    const int n = static_cast<int>(i) + k - 1;
+    for (int a = 0; a < d; ++a) comp[a][n] = J[i](a);
+    drift[n] = (J[i] - J.front()).template lpNorm<Eigen::Infinity>();
+    worst = std::max(worst, drift[n]);
+  }
+  for (int a = 0; a < d; ++a) table.add(prefix + std::to_string(a + 1), comp[a]);
+  table.add(prefix + "_drift", drift);
+  if (J0) J0->assign(J.front().data(), J.front().data() + d);
+  if (relative) *relative = worst / std::max(1.0, J.front().template lpNorm<Eigen::Infinity>());
+  return worst;
+}
+
 template <class P>
 void record_momentum(const P& problem, const Trajectory<P>& tr, const GroupElement<P, double>& g0, RunRecord& r) {
-  const auto J = spatial_momentum(problem, tr, g0);
-  if (J.empty()) return;
   r.has_momentum = true;
-  constexpr int k = P::order, d = P::Group::dim;
-  std::vector<double> t, drift;
-  std::vector<std::vector<double>> comp(d);
-  for (size_t i = 0; i < J.size(); ++i) {
-    t.push_back(tr.time(static_cast<int>(i) + k - 1));
-    for (int a = 0; a < d; ++a) comp[a].push_back(J[i](a));
-    const double e = (J[i] - J.front()).template lpNorm<Eigen::Infinity>();
-    drift.push_back(e);
-    r.momentum_drift = std::max(r.momentum_drift, e);
-  }
-  r.momentum_drift_relative = r.momentum_drift / std::max(1.0, J.front().template lpNorm<Eigen::Infinity>());
-  r.momentum_initial.assign(J.front().data(), J.front().data() + d);
-  r.momentum.add("t", t);
-  for (int a = 0; a < d; ++a) r.momentum.add("J" + std::to_string(a + 1), comp[a]);
-  r.momentum.add("drift", drift);
+  r.momentum_drift = momentum_columns(problem, tr, g0, "J", r.momentum, &r.momentum_initial, &r.momentum_drift_relative);
 }
 
 // Columns shared by the control and free beanie: t, psi, theta, x, y (nodes 0..N) and
