@@ -105,7 +105,8 @@ int main(int argc, char** argv) {
   Common c;
   auto scene_options = [&](CLI::App* sub, bool outputs) {
     sub->add_option("scene", c.scene, "the scene file (JSON; see the README's scene reference)")->required();
-    sub->add_option("--set", c.sets, "override a scene value, key.path=value (repeatable; value JSON or a word; null frees it)");
+    sub->add_option("--set", c.sets, "override a scene value, key.path=value (repeatable; value JSON or a word; null frees it)")
+        ->allow_extra_args(false);
     if (!outputs) return;
     sub->add_option("--out", c.out, "output directory (default: the scene's output.dir, else lpshoot-out/SCENE)");
     sub->add_flag("--no-plot", c.no_plot, "do not draw PNG plots");
