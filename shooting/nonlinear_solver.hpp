@@ -18,6 +18,10 @@ class NonlinearSystem {
   // Returns false when F cannot be evaluated at x (the flow failed): solvers then shorten the step.
   virtual bool residual(const Eigen::VectorXd& x, Eigen::VectorXd& F) = 0;
   virtual bool jacobian(const Eigen::VectorXd& x, Eigen::MatrixXd& J) = 0;
+  // The norm that judges progress (divergence) of full Newton steps, as opposed to convergence:
+  // a system whose rows are scaled for the stopping test (e.g. by per-row tolerances) returns
+  // the norm of the unscaled rows here.
+  virtual double progress_norm(const Eigen::VectorXd& F) const { return F.lpNorm<Eigen::Infinity>(); }
 };
 
 enum class Backend { Kinsol, Nlopt };

@@ -198,6 +198,9 @@ class ShootingSystem : public NonlinearSystem {
     return true;
   }
   void set_row_scaling(const Eigen::VectorXd& w) { w_ = w; }
+  double progress_norm(const Eigen::VectorXd& F) const override {
+    return w_.size() == F.size() ? F.cwiseQuotient(w_).lpNorm<Eigen::Infinity>() : F.lpNorm<Eigen::Infinity>();
+  }
 
   // Per-row tolerances: `tol` plus the roundoff floor of each row, 64 u |J_δ| |state|: the
   // rounding of the state's values (magnitudes |state|) propagated through the row's derivative
@@ -228,8 +231,16 @@ class ShootingSystem : public NonlinearSystem {
     }
     Eigen::MatrixXd Jd = J;  // J_x M = J_δ, per segment block of columns
     for (int i = 0; i < S; ++i) Jd.middleCols(i * n, n) = J.middleCols(i * n, n) * M_;
-    const Eigen::ArrayXd floor = 64 * std::numeric_limits<double>::epsilon() * (Jd.cwiseAbs() * mag).array();
+    constexpr double u = std::numeric_limits<double>::epsilon();
+    const Eigen::ArrayXd floor = 64 * u * (Jd.cwiseAbs() * mag).array();
     t.array() += floor.min(1e4 * tol);  // at most four digits conceded to roundoff: beyond, not converged
+    // A continuity row Δ^j/h^j of two nodal states cannot be known better than their rounding,
+    // ~u |state| / h^j, whatever the tolerance (h = 5e-4, j = 3: ~2e-6 for |p| ~ 1). A defect at
+    // that level means states equal to the last bit; this part is not capped.
+    const int first_continuity = size() - (S - 1) * n - terminal_rows();
+    for (int i = 0; i + 1 < S; ++i)
+      t.segment(first_continuity + i * n, n).array() +=
+          4 * u * (M_.cwiseAbs() * mag.segment((i + 1) * n, n)).array();
     return t;
   }
 
@@ -243,13 +254,19 @@ class ShootingSystem : public NonlinearSystem {
     runs.resize(S);
     starts.resize(S);
     Jr.resize(S);
-    for (int i = 0; i < S; ++i)
+    for (int i = 0; i < S; ++i) {
       starts[i] = retract_extended(refs_[i], Eigen::VectorXd(Minv_ * x.segment(i * n, n)),
                                    sensitivities ? &Jr[i] : nullptr);
+      if (sensitivities) Jr[i] = Jr[i] * Minv_;  // d(tangent at the start)/d(unknowns)
+    }
+    // The flow propagates the unknowns' own directions (Jr), not the nodal ones: a nodal
+    // direction such as "move p_{2k-1} alone" is a (2k-1)-th difference of size h^{-(2k-1)}, whose
+    // sensitivity (~N^{2k-1}) would be recombined into O(1) difference-basis entries afterwards by
+    // cancellation, losing ~(2k-1) log10(1/h) digits twice (electron, N = 1000 in two segments:
+    // Jacobian entries wrong by O(1) and Newton stalling on a linear problem).
     auto work = [&](int i) {
       const int N_local = starts_[i + 1] - starts_[i] + 2 * P::order - 1;
-      const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(n, n);
-      runs[i] = flow_.run(starts[i].s, N_local, sensitivities ? &I : nullptr, starts[i].g);
+      runs[i] = flow_.run(starts[i].s, N_local, sensitivities ? &Jr[i] : nullptr, starts[i].g);
     };
     const int T = std::max(1, std::min(S, threads_ > 0 ? threads_ : static_cast<int>(std::thread::hardware_concurrency())));
     if (T == 1) {
@@ -285,6 +302,10 @@ class ShootingSystem : public NonlinearSystem {
       if (c.end == End::Terminal) names.push_back(c.name);
     return names;
   }
+  int terminal_rows() const {
+    return static_cast<int>(std::count_if(bvp_.conditions.begin(), bvp_.conditions.end(),
+                                          [](const auto& c) { return c.end == End::Terminal; }));
+  }
   BoundaryState<P> end_state(const FlowResult<P>& run) const {
     const int N_local = run.trajectory.N();
     return {run.trajectory.state(N_local - P::order + 1), run.g_first};
@@ -297,8 +318,6 @@ class ShootingSystem : public NonlinearSystem {
     std::vector<Eigen::MatrixXd> Jr;
     if (!propagate(x, J != nullptr, runs, starts, Jr)) return false;
     const int S = segments(), N = size();
-    if (J)
-      for (auto& j : Jr) j = j * Minv_;  // d(tangent)/d(unknowns)
     F.resize(N);
     if (J) J->setZero(N, N);
     int row = 0;
@@ -315,7 +334,7 @@ class ShootingSystem : public NonlinearSystem {
         // d/d(end) of log(start^{-1} end) ≈ I and d/d(start) ≈ -I at the solution; exact forms:
         Eigen::MatrixXd De, Ds;
         difference_jacobians(e, starts[i + 1], De, Ds);
-        J->block(row, i * n, n, n) = M_ * De * runs[i].sensitivity * Jr[i];
+        J->block(row, i * n, n, n) = M_ * De * runs[i].sensitivity;
         J->block(row, (i + 1) * n, n, n) = M_ * Ds * Jr[i + 1];
       }
       row += n;
@@ -323,7 +342,7 @@ class ShootingSystem : public NonlinearSystem {
     const BoundaryState<P> e = end_state(runs[S - 1]);
     boundary_block(bvp_, End::Terminal, e, R, J ? &JB : nullptr);
     F.segment(row, R.size()) = R;
-    if (J) J->block(row, (S - 1) * n, R.size(), n) = JB * runs[S - 1].sensitivity * Jr[S - 1];
+    if (J) J->block(row, (S - 1) * n, R.size(), n) = JB * runs[S - 1].sensitivity;
     row += R.size();
     return row == N;
   }
@@ -491,23 +510,53 @@ ShootingResult<P> solve_bvp(const BoundaryValueProblem<P>& bvp, const ShootingGu
       out.rank = std::min(out.rank, rank);
       const auto names = system.row_names();
       for (int c = out.rank; c < sv.size(); ++c) {  // left null vectors: dependent conditions
+        // The (at most four) largest weights of the left null vector name the dependent rows.
         const Eigen::VectorXd u = svd.matrixU().col(c);
-        std::string dep;
+        std::vector<int> rows;
         for (int i = 0; i < u.size(); ++i)
-          if (std::abs(u(i)) > 0.1) dep += (dep.empty() ? "" : " + ") + std::to_string(u(i)).substr(0, 6) + "·[" + names[i] + "]";
+          if (std::abs(u(i)) > 0.1) rows.push_back(i);
+        std::sort(rows.begin(), rows.end(), [&](int a, int b) { return std::abs(u(a)) > std::abs(u(b)); });
+        std::string dep;
+        for (size_t j = 0; j < rows.size() && j < 4; ++j)
+          dep += (j ? " + " : "") + std::to_string(u(rows[j])).substr(0, 6) + "·[" + names[rows[j]] + "]";
+        if (rows.size() > 4) dep += " + ...";
         out.dependent_conditions.push_back(dep);
       }
     }
   }
-  if (out.rank < out.unknowns) {
+  const std::string solver_msg = so.message.empty() ? std::string("the solver did not converge") : so.message + " x tolerance";
+  // A solver that ran away from the guess leaves a Jacobian whose rank says nothing about the data.
+  const bool diverged = so.status != SolverStatus::Converged && !so.residual_history.empty() &&
+                        !(out.residual_norm <= so.residual_history.front());
+  if (out.rank < out.unknowns && !diverged) {
     std::string msg = "the shooting Jacobian is rank deficient (rank " + std::to_string(out.rank) + " of " +
-                      std::to_string(out.unknowns) + "): the boundary data are redundant or inconsistent; dependent: ";
-    for (size_t i = 0; i < out.dependent_conditions.size(); ++i) msg += (i ? "; " : "") + out.dependent_conditions[i];
-    if (so.status != SolverStatus::Converged) msg += " (" + so.message + ")";
+                      std::to_string(out.unknowns) +
+                      "): redundant or inconsistent boundary data, or a discrete problem that is (nearly) singular at "
+                      "this step size; dependent: ";
+    for (size_t i = 0; i < out.dependent_conditions.size() && i < 3; ++i) msg += (i ? "; " : "") + out.dependent_conditions[i];
+    if (out.dependent_conditions.size() > 3)
+      msg += "; and " + std::to_string(out.dependent_conditions.size() - 3) + " more";
+    if (so.status != SolverStatus::Converged) msg += " (" + solver_msg + ")";
     return finish(ShootingStatus::RankDeficient, msg);
   }
-  if (so.status != SolverStatus::Converged)
-    return finish(ShootingStatus::NotConverged, so.message.empty() ? "the solver did not converge" : so.message);
+  if (so.status != SolverStatus::Converged) {
+    std::string msg = solver_msg;
+    if (diverged)
+      msg += "; the residual grew from " + format_residual(so.residual_history.front()) + " at the guess to " +
+             format_residual(out.residual_norm) + (out.rank < out.unknowns ? ", and the Jacobian there has rank " +
+                                                       std::to_string(out.rank) + " of " + std::to_string(out.unknowns)
+                                                                           : std::string()) +
+             ": try multiple shooting with more segments, a smaller h, or a better guess";
+    else if (out.residual_norm < 1e3 && !so.residual_history.empty() &&
+             so.residual_history.front() > 1e3 * out.residual_norm) {
+      int longest = 0;
+      for (int i = 0; i < S; ++i) longest = std::max(longest, starts[i + 1] - starts[i]);
+      msg += "; it stalled close to the tolerance after a " + format_residual(so.residual_history.front() / out.residual_norm) +
+             "-fold reduction: the roundoff floor of the flow on this grid (h = " + format_residual(bvp.h()) + ", " +
+             std::to_string(longest) + " steps per segment): use shorter segments or a looser tolerance";
+    }
+    return finish(ShootingStatus::NotConverged, msg);
+  }
   return finish(ShootingStatus::Converged, "");
 }
 

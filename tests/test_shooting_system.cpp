@@ -91,3 +91,69 @@ TEST(ShootingSystem, UnstableElectronNeedsMultipleShooting) {
   // Single shooting either fails or is far less accurate than multiple shooting.
   EXPECT_TRUE(!a.ok() || error(a) > 10 * error(b));
 }
+
+TEST(ShootingSystem, LinearProblemJacobianStaysExactOnFineGrids) {
+  // The electron's discrete flow is linear, so the shooting residual is affine in the unknowns:
+  // F(x + e_j) - F(x) = J e_j exactly, up to roundoff, for a unit step. On a fine grid the
+  // difference-basis unknowns are recombinations of nodal directions of size h^{-3}; propagating
+  // nodal directions and recombining afterwards (as the engine once did) left entries wrong by
+  // O(1) at N = 1000 (worst relative error 45) and Newton stalled on this linear problem.
+  const Electron e{1.0, 1.0, Eigen::Vector3d(0, 0, 1.0), 1.0};
+  const ElectronBoundary start{Eigen::Vector3d(1.0, 0.0, 0.5), Eigen::Vector3d(0.0, 1.0, 0.0)};
+  const ElectronBoundary end{Eigen::Vector3d(0.0, 1.0, -0.5), Eigen::Vector3d(-1.0, 0.0, 0.2)};
+  const int N = 1000;
+  const auto bvp = electron_bvp(e, 2.0, N, start, end, Closure::SecondOrder);
+  const auto guess = electron_guess(bvp, start, end);
+  for (int S : {1, 2, 8}) {
+    std::vector<int> starts;
+    for (int i = 0; i <= S; ++i) starts.push_back(2 + static_cast<int>(std::lround(double(N - 3) * i / S)));
+    std::vector<BoundaryState<Electron>> refs;
+    for (int i = 0; i < S; ++i) refs.push_back({guess.trajectory.state(starts[i]), Trivial::identity<double>()});
+    detail::ShootingSystem<Electron> sys(bvp, refs, starts, NewtonOptions{}, 1);
+    const Eigen::VectorXd x = Eigen::VectorXd::Zero(sys.size());
+    Eigen::VectorXd F, Fj;
+    Eigen::MatrixXd J;
+    ASSERT_TRUE(sys.residual(x, F) && sys.jacobian(x, J));
+    double worst = 0;
+    for (int j = 0; j < sys.size(); ++j) {
+      Eigen::VectorXd xj = x;
+      xj(j) += 1.0;
+      ASSERT_TRUE(sys.residual(xj, Fj));
+      const Eigen::VectorXd diff = Fj - F;
+      worst = std::max(worst, (J.col(j) - diff).lpNorm<Eigen::Infinity>() / std::max(1.0, diff.lpNorm<Eigen::Infinity>()));
+    }
+    std::printf("N = %d, %d segments: max relative error of the exact Jacobian on an affine residual %.2e\n", N, S, worst);
+    EXPECT_LT(worst, 1e-4);  // measured ~1e-5: the flow's roundoff over ~1000 steps
+  }
+  ShootingOptions opt;
+  opt.method = ShootingMethod::Multiple;
+  opt.segments = 2;
+  const auto r = solve_bvp(bvp, guess, opt);
+  ASSERT_TRUE(r.ok()) << r.message;
+  EXPECT_LE(r.iterations, 3) << "a linear problem: one Newton step, plus roundoff";
+}
+
+TEST(ShootingSystem, ManySegmentsConvergeLikeFewOnANonlinearProblem) {
+  // Beanie with V = 1 - cos ψ (nonlinear): the Newton step does not depend on the row scaling,
+  // but a line search's merit does; with rows scaled by tolerances spanning 1e4 the line search
+  // once took 19 iterations at 50 segments against 3 at 4. Full steps come first now.
+  BeanieControl b;
+  b.par = {1.0, 1.0, 0.5, 1.0};
+  BeanieBoundary s, e;
+  s.psi = 0, s.psi_dot = 0, s.theta = 0, s.x = 0, s.y = 0, s.Omega1 = 0.5, s.Omega2 = 0.2;
+  e.psi = 1.0, e.psi_dot = 0, e.theta = 1.0;
+  const auto bvp = beanie_bvp(b, 2.0, 200, s, e, Closure::SecondOrder);
+  const auto guess = beanie_guess(bvp, s, e);
+  ShootingOptions few, many;
+  few.method = many.method = ShootingMethod::Multiple;
+  few.segments = 4;
+  many.segments = 50;
+  const auto a = solve_bvp(bvp, guess, few), c = solve_bvp(bvp, guess, many);
+  ASSERT_TRUE(a.ok()) << a.message;
+  ASSERT_TRUE(c.ok()) << c.message;
+  std::printf("beanie N = 200: 4 segments %d iterations, 50 segments %d iterations\n", a.iterations, c.iterations);
+  EXPECT_LE(c.iterations, a.iterations + 2);
+  double diff = 0;
+  for (int n = 0; n <= 200; ++n) diff = std::max(diff, std::abs(a.trajectory.p[n](0) - c.trajectory.p[n](0)));
+  EXPECT_LT(diff, 1e-8);
+}
