@@ -54,6 +54,8 @@ struct ContinuationOptions {
   double initial_step = 0.25;  // as a fraction of |to - from|
   double min_step = 1e-4;      // same units; smaller steps give up
   int max_solves = 200;
+  // Called after each solve with the parameter tried, whether it converged and its iterations.
+  std::function<void(double, bool, int)> on_solve;
 };
 
 template <class P>
@@ -75,6 +77,7 @@ ContinuationResult<P> continuation(const std::function<BoundaryValueProblem<P>(d
   const double span = to - from;
   out.result = solve_bvp(make(from), guess, opt);
   ++out.solves;
+  if (copt.on_solve) copt.on_solve(from, out.result.ok(), out.result.iterations);
   if (!out.result.ok()) {
     out.result.message = "continuation could not start at " + std::to_string(from) + ": " + out.result.message;
     return out;
@@ -86,6 +89,7 @@ ContinuationResult<P> continuation(const std::function<BoundaryValueProblem<P>(d
     const double next = std::abs(to - out.parameter) <= std::abs(step) ? to : out.parameter + step;
     auto r = solve_bvp(make(next), as_guess(out.result), opt);
     ++out.solves;
+    if (copt.on_solve) copt.on_solve(next, r.ok(), r.iterations);
     if (r.ok()) {
       out.result = std::move(r);
       out.parameter = next;

@@ -211,6 +211,10 @@ Written write_run(const Scene& scene, const RunRecord& r, const std::string& dir
   }
   if (!r.constraints.empty()) j["constraints"] = r.constraints;
   j["tolerance"] = r.tolerance;
+  if (!r.continuation_parameter.empty())
+    j["continuation"] = {{"parameter", "parameters." + r.continuation_parameter},
+                         {"path", r.continuation_path},
+                         {"solves", r.continuation_solves}};
   j["cost"] = r.has_cost ? finite_or_null(r.cost) : json(nullptr);
   j["action"] = finite_or_null(r.action);
   j["iterations"] = r.iterations;

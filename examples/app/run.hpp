@@ -56,6 +56,11 @@ struct RunRecord {
   double physical_momentum_drift = 0;
   std::vector<double> physical_momentum_initial;
   double wall_time_s = 0;
+  // solver.continuation: the parameter values solved, in order (the last is the scene's when
+  // it was reached), and the number of solves including rejected steps.
+  std::string continuation_parameter;
+  std::vector<double> continuation_path;
+  int continuation_solves = 0;
   std::vector<std::pair<std::string, double>> final_state;
   Table trajectory;                        // first column t
   Table momentum;                          // t, J1.., J_drift (, P1.., P_drift) when has_momentum

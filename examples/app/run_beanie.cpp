@@ -8,18 +8,24 @@ RunRecord solve_beanie(const Scene& s, const Progress& progress) {
   RunRecord r = start_record("solve", s);
   describe_solver(s, r);
   r.constraints = constraints_name(s.constraints);
+  const auto make = [](const Scene& sc) {
+    BeanieControl bc;
+    bc.par = sc.beanie;
+    bc.variant = sc.constraints;
+    try {
+      return problems::beanie_bvp(bc, sc.T, sc.N, sc.beanie_start, sc.beanie_end, sc.closure);
+    } catch (const std::invalid_argument& e) {
+      throw SceneError(sc.file + ": boundary: " + e.what());
+    }
+  };
+  const auto guess = [&](const BoundaryValueProblem<BeanieControl>& bvp) {
+    return problems::beanie_guess(bvp, s.beanie_start, s.beanie_end);
+  };
+  const auto res = solve_scene<BeanieControl>(s, make, guess, progress, r);
+  record_outcome(res, r);
   BeanieControl b;
   b.par = s.beanie;
   b.variant = s.constraints;
-  BoundaryValueProblem<BeanieControl> bvp{b, s.N, s.T, {}};
-  try {
-    bvp = problems::beanie_bvp(b, s.T, s.N, s.beanie_start, s.beanie_end, s.closure);
-  } catch (const std::invalid_argument& e) {
-    throw SceneError(s.file + ": boundary: " + e.what());
-  }
-  const auto res = solve_bvp(bvp, problems::beanie_guess(bvp, s.beanie_start, s.beanie_end),
-                             options_with_progress(s, progress));
-  record_outcome(res, r);
   const Trajectory<BeanieControl>& tr = res.trajectory;
   if (tr.N() != s.N) return r;
 

@@ -4,7 +4,18 @@
 
 #include "run.hpp"
 
+#include <lpshoot/shooting/continuation.hpp>
+
+#include <chrono>
+#include <cstdio>
+
 namespace lpshoot::app {
+
+inline std::string format_value(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", x);
+  return buf;
+}
 
 inline RunRecord start_record(const std::string& command, const Scene& s) {
   RunRecord r;
@@ -36,11 +47,51 @@ inline ShootingOptions options_with_progress(const Scene& s, const Progress& pro
   return opt;
 }
 
+// Solves the scene's boundary value problem (make: Scene -> BoundaryValueProblem<P>; guess:
+// problem -> ShootingGuess<P>), through solver.continuation when the scene asks for it. The
+// continuation record goes into r.
+template <class P, class Make, class Guess>
+ShootingResult<P> solve_scene(const Scene& s, const Make& make, const Guess& guess, const Progress& progress,
+                              RunRecord& r) {
+  const ShootingOptions opt = options_with_progress(s, progress);
+  if (!s.continuation) {
+    const BoundaryValueProblem<P> bvp = make(s);
+    return solve_bvp(bvp, guess(bvp), opt);
+  }
+  const Scene::Continuation& c = *s.continuation;
+  const auto t0 = std::chrono::steady_clock::now();
+  auto at = [&](double v) { return make(with_parameter(s, c.parameter, v)); };
+  ContinuationOptions copt;
+  copt.initial_step = c.initial_step;
+  if (progress)
+    copt.on_solve = [&](double v, bool ok, int iterations) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "continuation: parameters.%s = %.6g %s (%d iterations)", c.parameter.c_str(), v,
+                    ok ? "solved" : "failed, step halved", iterations);
+      progress(buf);
+    };
+  const BoundaryValueProblem<P> first = at(c.from);
+  ContinuationResult<P> cont = continuation<P>(at, c.from, c.to, guess(first), opt, copt);
+  r.continuation_parameter = c.parameter;
+  r.continuation_path = cont.path;
+  r.continuation_solves = cont.solves;
+  ShootingResult<P> res = std::move(cont.result);
+  if (!cont.reached && res.ok()) res.status = ShootingStatus::NotConverged;
+  if (!cont.reached)
+    res.message = "continuation in parameters." + c.parameter + " did not reach " + format_value(c.to) + ": " + res.message;
+  res.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return res;
+}
+
 template <class P>
 void record_outcome(const ShootingResult<P>& res, RunRecord& r) {
   r.converged = res.ok();
   r.status = status_name(res.status);
   r.message = res.ok() ? "converged in " + std::to_string(res.iterations) + " iterations" : res.message;
+  if (res.ok() && !r.continuation_path.empty())
+    r.message += " (continuation in parameters." + r.continuation_parameter + ": " +
+                 std::to_string(r.continuation_path.size()) + " values solved in " +
+                 std::to_string(r.continuation_solves) + " solves)";
   r.iterations = res.iterations;
   r.residual_norm = res.residual_norm;
   r.raw_residual_norm = res.raw_residual_norm;

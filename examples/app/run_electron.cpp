@@ -9,9 +9,13 @@ RunRecord solve_electron(const Scene& s, const Progress& progress) {
   using problems::Electron;
   RunRecord r = start_record("solve", s);
   describe_solver(s, r);
-  const auto bvp = problems::electron_bvp(s.electron, s.T, s.N, s.electron_start, s.electron_end, s.closure);
-  const auto res = solve_bvp(bvp, problems::electron_guess(bvp, s.electron_start, s.electron_end),
-                             options_with_progress(s, progress));
+  const auto make = [](const Scene& sc) {
+    return problems::electron_bvp(sc.electron, sc.T, sc.N, sc.electron_start, sc.electron_end, sc.closure);
+  };
+  const auto guess = [&](const BoundaryValueProblem<Electron>& bvp) {
+    return problems::electron_guess(bvp, s.electron_start, s.electron_end);
+  };
+  const auto res = solve_scene<Electron>(s, make, guess, progress, r);
   record_outcome(res, r);
   const Trajectory<Electron>& tr = res.trajectory;
   if (tr.N() != s.N) return r;  // no trajectory to report (the flow failed or the problem was invalid)

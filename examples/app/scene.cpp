@@ -136,6 +136,11 @@ class Reader {
     return has(key) ? std::optional<Reader>(object(key)) : std::nullopt;
   }
 
+  static std::string format_exact(double x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.17g", x);
+    return buf;
+  }
   static std::string format(double x) {
     std::ostringstream s;
     s << x;
@@ -206,14 +211,23 @@ void read_solver(const Reader& r, Scene& s) {
   if (s.problem == ProblemKind::BeanieFree) {  // a simulation: only the per-step Newton is tuned
     r.allow({"tolerance", "max_iterations"});
     s.shooting.step.step_tolerance = r.positive("tolerance", s.shooting.step.step_tolerance);
+    if (s.shooting.step.step_tolerance < 1e-15 || s.shooting.step.step_tolerance > 1)
+      r.fail("must be between 1e-15 and 1 (got " + Reader::format(s.shooting.step.step_tolerance) + ")", "tolerance");
     s.shooting.step.max_iterations = r.integer("max_iterations", s.shooting.step.max_iterations);
     if (s.shooting.step.max_iterations < 1) r.fail("must be >= 1", "max_iterations");
     return;
   }
-  r.allow({"method", "segments", "backend", "tolerance", "max_iterations", "threads"});
+  r.allow({"method", "segments", "backend", "tolerance", "max_iterations", "threads", "continuation"});
   s.shooting.method = read_method(r.choice("method", {"single", "multiple"}, "single"));
   const int max_segments = s.N - 2 * s.order() + 1;
-  s.shooting.segments = r.integer("segments", s.shooting.method == ShootingMethod::Multiple ? std::min(4, max_segments) : 1);
+  s.auto_segments = !r.has("segments") || r.at("segments").is_string();
+  if (s.auto_segments) {
+    if (r.has("segments") && r.at("segments").get<std::string>() != "auto")
+      r.fail("must be an integer or \"auto\" (got " + r.at("segments").dump() + ")", "segments");
+    s.shooting.segments = auto_segments(s.N, s.order());
+  } else {
+    s.shooting.segments = r.integer("segments", 1);
+  }
   if (s.shooting.segments < 1 || s.shooting.segments > max_segments)
     r.fail("must be between 1 and N - 2k + 1 = " + std::to_string(max_segments) + " (got " +
                std::to_string(s.shooting.segments) + ")",
@@ -221,6 +235,9 @@ void read_solver(const Reader& r, Scene& s) {
   if (s.shooting.method == ShootingMethod::Single) s.shooting.segments = 1;  // segments: multiple shooting only
   s.shooting.solver.backend = r.choice("backend", {"kinsol", "nlopt"}, "kinsol") == "nlopt" ? Backend::Nlopt : Backend::Kinsol;
   s.shooting.solver.tolerance = r.positive("tolerance", 1e-10);
+  if (s.shooting.solver.tolerance < 1e-14 || s.shooting.solver.tolerance > 1)
+    r.fail("must be between 1e-14 (double precision roundoff) and 1 (got " + Reader::format(s.shooting.solver.tolerance) + ")",
+           "tolerance");
   s.shooting.solver.max_iterations = r.integer("max_iterations", 50);
   if (s.shooting.solver.max_iterations < 1) r.fail("must be >= 1", "max_iterations");
   s.shooting.threads = r.integer("threads", 0);
@@ -311,22 +328,78 @@ void read_beanie_free(const Reader& root, Scene& s) {
   }
 }
 
-}  // namespace
-
-Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
-  Scene s;
-  s.file = path;
-  std::ifstream in(path);
-  if (!in) throw SceneError(path + ": cannot open the scene file");
-  json j;
+json parse_json(std::istream& in, const std::string& path) {
   try {
-    j = json::parse(in);
+    return json::parse(in);
   } catch (const json::exception& e) {  // parse errors, and numbers out of range (1e999)
     std::string what = e.what();  // "[json.exception.parse_error.101] parse error at line 3, column 5: ..."
     const size_t at = what.find("] ");
     throw SceneError(path + ": invalid JSON: " + (at == std::string::npos ? what : what.substr(at + 2)));
   }
+}
+
+Scene parse_scene(const json& j, const std::string& path);
+
+void read_continuation(const Reader& so, const json& scene, Scene& s) {
+  if (!so.has("continuation")) return;
+  const Reader c = so.object("continuation");
+  c.allow({"parameter", "from", "initial_step"});
+  Scene::Continuation cont;
+  cont.parameter = c.string("parameter", "");
+  if (cont.parameter.empty()) c.fail("missing (required): a key under parameters, e.g. \"potential.amplitude\"", "parameter");
+  const json* node = &scene.at("parameters");
+  std::stringstream ss(cont.parameter);
+  for (std::string k; node && std::getline(ss, k, '.');) {
+    if (node->is_object() && node->contains(k))
+      node = &(*node)[k];
+    else if (node->is_array() && !k.empty() && k.find_first_not_of("0123456789") == std::string::npos &&
+             std::stoul(k) < node->size())
+      node = &(*node)[std::stoul(k)];
+    else
+      node = nullptr;
+  }
+  if (!node || !node->is_number())
+    c.fail("parameters." + cont.parameter + " must be a number given in the scene's parameters", "parameter");
+  cont.to = node->get<double>();
+  cont.from = c.number("from");
+  cont.initial_step = c.positive("initial_step", 0.25);
+  if (cont.initial_step > 1) c.fail("must be in (0, 1], a fraction of |to - from|", "initial_step");
+  json start = scene;
+  start["solver"].erase("continuation");
+  apply_override(start["parameters"], cont.parameter + "=" + Reader::format_exact(cont.from));
+  try {
+    parse_scene(start, s.file);
+  } catch (const SceneError& e) {
+    std::string why = e.what();
+    if (why.rfind(s.file + ": ", 0) == 0) why = why.substr(s.file.size() + 2);
+    c.fail("the scene is not valid at the start value " + Reader::format(cont.from) + " (" + why + ")", "from");
+  }
+  s.continuation = cont;
+}
+
+}  // namespace
+
+Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
+  std::ifstream in(path);
+  if (!in) throw SceneError(path + ": cannot open the scene file");
+  json j = parse_json(in, path);
   for (const auto& o : overrides) apply_override(j, o);
+  return parse_scene(j, path);
+}
+
+Scene with_parameter(const Scene& s, const std::string& parameter, double value) {
+  std::istringstream in(s.effective_json);
+  json j = parse_json(in, s.file);
+  if (j.contains("solver") && j["solver"].is_object()) j["solver"].erase("continuation");
+  apply_override(j["parameters"], parameter + "=" + Reader::format_exact(value));
+  return parse_scene(j, s.file);
+}
+
+namespace {
+
+Scene parse_scene(const json& j, const std::string& path) {
+  Scene s;
+  s.file = path;
   s.effective_json = j.dump(2);
 
   const Reader root(j, "", path);
@@ -370,9 +443,10 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
                             : problems::BeanieConstraints::ExactRotation;
     }
   }
-  if (const auto so = root.optional_object("solver"))
+  if (const auto so = root.optional_object("solver")) {
     read_solver(*so, s);
-  else
+    read_continuation(*so, j, s);
+  } else
     read_solver(Reader(json::object(), "solver", path), s);
 
   const std::string stem = std::filesystem::path(path).stem().string();
@@ -385,6 +459,8 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
   }
   return s;
 }
+
+}  // namespace
 
 const char* closure_name(Closure c) { return c == Closure::Paper ? "paper" : "second_order"; }
 const char* constraints_name(problems::BeanieConstraints c) {

@@ -5,6 +5,7 @@
 #include <lpshoot/problems/beanie_bvp.hpp>
 #include <lpshoot/problems/electron_bvp.hpp>
 
+#include <algorithm>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -37,6 +38,16 @@ struct Scene {
   Closure closure = Closure::SecondOrder;
   problems::BeanieConstraints constraints = problems::BeanieConstraints::ExactRotation;
   ShootingOptions shooting;
+  bool auto_segments = true;  // solver.segments "auto" (the default): see auto_segments()
+
+  // solver.continuation: solve at parameters.<parameter> = from first, then step towards the
+  // scene's own value, each solve starting from the last solution (shooting/continuation.hpp).
+  struct Continuation {
+    std::string parameter;  // key path under "parameters", e.g. "potential.amplitude" or "B.2"
+    double from = 0, to = 0;
+    double initial_step = 0.25;  // fraction of |to - from|
+  };
+  std::optional<Continuation> continuation;
 
   std::string out_dir;
   bool plot = true;
@@ -53,9 +64,17 @@ struct Scene {
   bool is_optimal_control() const { return problem != ProblemKind::BeanieFree; }
 };
 
+// Multiple shooting's default segment count: segments of at most 100 steps. A k = 2 recursion
+// rounds its nodal states each step and amplifies that like L^4 eps over L steps (METHOD.md §5);
+// 100 steps keep it near 1e-8 of the state's size, and the segment count grows only with N.
+inline int auto_segments(int N, int k) { return std::clamp((N + 99) / 100, 1, N - 2 * k + 1); }
+
 // Reads, applies the --set overrides ("key.path=value", value parsed as JSON when it is JSON,
 // else taken as a string; "null" removes the key), validates. Throws SceneError.
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides = {});
+
+// The scene with parameters.<parameter> set to value, validated again (throws SceneError).
+Scene with_parameter(const Scene& s, const std::string& parameter, double value);
 
 const char* closure_name(Closure c);
 const char* constraints_name(problems::BeanieConstraints c);

@@ -64,10 +64,11 @@ SweepRecord run_sweep(const Scene& scene, const std::string& command, const Swee
       if (scene.is_optimal_control()) {
         s.shooting.method = m;
         s.shooting.solver.backend = b;
-        int segments = opt.steps_per_segment > 0 ? (N + opt.steps_per_segment - 1) / opt.steps_per_segment
-                                                 : scene.shooting.segments;
-        if (m == ShootingMethod::Multiple && scene.shooting.method == ShootingMethod::Single && opt.steps_per_segment <= 0)
-          segments = 4;  // the scene asked for single shooting: multiple shooting's default
+        int segments = scene.shooting.segments;
+        if (opt.steps_per_segment > 0)
+          segments = (N + opt.steps_per_segment - 1) / opt.steps_per_segment;
+        else if (scene.auto_segments || scene.shooting.method == ShootingMethod::Single)
+          segments = auto_segments(N, k);  // per grid (a single-shooting scene: multiple shooting's default)
         s.shooting.segments = std::clamp(segments, 1, N - 2 * k + 1);
         sr.method = method_name(m);
         sr.backend = backend_name(b);

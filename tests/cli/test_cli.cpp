@@ -216,6 +216,48 @@ TEST(FailedRuns, RedundantBoundaryDataAreReportedAsRankDeficient) {
   EXPECT_NE(report["message"].get<std::string>().find("terminal Omega3"), std::string::npos) << report["message"];
 }
 
+TEST(FailedRuns, RoundoffFloorIsNamedAndAutomaticSegmentsAvoidIt) {
+  // h = 1/3000 with 1000-step segments: the rounding of nodal states, amplified over a segment,
+  // exceeds the tolerance in the third divided differences; the run says so. Segments of at most
+  // 100 steps ("auto", the default) converge on the same grid.
+  const fs::path work = scratch("roundoff");
+  const std::string base = "solve '" + scene("electron") + "' --no-plot --set horizon.N=6000 ";
+  const Outcome o = run_cli(base + "--set solver.segments=6 --out '" + (work / "long").string() + "'", work);
+  EXPECT_EQ(o.code, 1) << o.out;
+  const json failed = json::parse(std::ifstream(work / "long" / "report.json"));
+  EXPECT_EQ(failed["status"], "not_converged");
+  EXPECT_NE(failed["message"].get<std::string>().find("roundoff floor"), std::string::npos) << failed["message"];
+  EXPECT_LT(failed["residual_norm"].get<double>(), 1e3);
+  const Outcome a = run_cli(base + "--set solver.segments=auto --out '" + (work / "auto").string() + "'", work);
+  ASSERT_EQ(a.code, 0) << a.out << a.err;
+  const json ok = json::parse(std::ifstream(work / "auto" / "report.json"));
+  EXPECT_EQ(ok["segments"], 60);
+  EXPECT_LE(ok["iterations"].get<int>(), 12);
+  EXPECT_NEAR(ok["final_state"]["x2"].get<double>(), 1.0, 1e-8);  // the terminal position is hit
+}
+
+TEST(Continuation, StiffPotentialIsReachedFromTheFreeProblem) {
+  // V = 100 (1 - cos ψ): multiple shooting from the interpolated guess diverges; continuation in
+  // the amplitude from 0 reaches it. Oracle: single shooting converges here directly, and both
+  // must be the same discrete optimum (cost and final state).
+  const fs::path work = scratch("continuation");
+  const std::string base = "solve '" + scene("beanie") + "' --no-plot --set parameters.potential.amplitude=100 ";
+  const Outcome c = run_cli(base + "--set 'solver.continuation={\"parameter\": \"potential.amplitude\", \"from\": 0}' --out '" +
+                                (work / "cont").string() + "'", work);
+  ASSERT_EQ(c.code, 0) << c.out << c.err;
+  const json cont = json::parse(std::ifstream(work / "cont" / "report.json"));
+  EXPECT_EQ(cont["continuation"]["parameter"], "parameters.potential.amplitude");
+  EXPECT_DOUBLE_EQ(cont["continuation"]["path"].front().get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(cont["continuation"]["path"].back().get<double>(), 100.0);
+  EXPECT_GE(cont["continuation"]["solves"].get<int>(), 2);
+  const Outcome s = run_cli(base + "--set solver.method=single --out '" + (work / "single").string() + "'", work);
+  ASSERT_EQ(s.code, 0) << s.out << s.err;
+  const json single = json::parse(std::ifstream(work / "single" / "report.json"));
+  EXPECT_NEAR(cont["cost"].get<double>(), single["cost"].get<double>(), 1e-8 * single["cost"].get<double>());
+  for (const char* key : {"psi", "theta", "x", "y", "Omega1", "Omega2"})
+    EXPECT_NEAR(cont["final_state"][key].get<double>(), single["final_state"][key].get<double>(), 1e-8) << key;
+}
+
 TEST(Sweep, ElectronOrdersAgainstTheExactOptimum) {
   const fs::path work = scratch("sweep_electron");
   for (const std::string closure : {"second_order", "paper"}) {
@@ -311,6 +353,15 @@ TEST_F(BadInput, EachClassFailsCleanlyNamingTheKey) {
       {"bad_choice", "solve " + e + "--set solver.backend=ipopt", "solver.backend: must be one of kinsol, nlopt"},
       {"segments", "solve " + e + "--set solver.segments=0", "solver.segments: must be between 1 and"},
       {"tolerance", "solve " + e + "--set solver.tolerance=-1", "solver.tolerance: must be > 0"},
+      {"tolerance_below_roundoff", "solve " + e + "--set solver.tolerance=1e-16", "solver.tolerance: must be between 1e-14"},
+      {"segments_word", "solve " + e + "--set solver.segments=many", "solver.segments: must be an integer or \"auto\""},
+      {"continuation_unknown_parameter",
+       "solve " + e + "--set 'solver.continuation={\"parameter\": \"mass\", \"from\": 1}'",
+       "solver.continuation.parameter: parameters.mass must be a number given in the scene's parameters"},
+      {"continuation_invalid_start", "solve " + e + "--set 'solver.continuation={\"parameter\": \"m\", \"from\": 0}'",
+       "solver.continuation.from: the scene is not valid at the start value 0 (parameters.m: must be > 0"},
+      {"continuation_missing_from", "solve " + e + "--set 'solver.continuation={\"parameter\": \"m\"}'",
+       "solver.continuation.from: missing (required)"},
       {"missing_required", "solve " + e + "--set horizon=null", "horizon: missing (required)"},
       {"velocity_without_position", "solve " + e + "--set boundary.final.position=null",
        "boundary.final.velocity: a velocity without a position"},
