@@ -1,0 +1,85 @@
+// The solver backends on small systems with known behaviour: a root where full Newton steps
+// diverge (the line-search fallback must take over), a residual with a noise floor above the
+// tolerance (a stall, reported as such), and a root both backends reach from a fair start.
+#include <lpshoot/shooting/nonlinear_solver.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace lpshoot;
+
+namespace {
+
+// F(x) = atan(x - a) per component: Newton from |x - a| > 1.39 overshoots further each step.
+struct Atan : NonlinearSystem {
+  Eigen::VectorXd a;
+  int size() const override { return static_cast<int>(a.size()); }
+  bool residual(const Eigen::VectorXd& x, Eigen::VectorXd& F) override {
+    F = (x - a).array().atan().matrix();
+    return true;
+  }
+  bool jacobian(const Eigen::VectorXd& x, Eigen::MatrixXd& J) override {
+    J = (1.0 / (1.0 + (x - a).array().square())).matrix().asDiagonal();
+    return true;
+  }
+};
+
+// F(x) = x + noise of size 1e-7 that changes with every evaluation: the residual cannot go below
+// ~1e-7, so a tolerance of 1e-10 cannot be met.
+struct Noisy : NonlinearSystem {
+  int calls = 0;
+  int size() const override { return 2; }
+  bool residual(const Eigen::VectorXd& x, Eigen::VectorXd& F) override {
+    ++calls;
+    F = x + 1e-7 * Eigen::Vector2d(std::sin(12.9898 * calls), std::cos(78.233 * calls));
+    return true;
+  }
+  bool jacobian(const Eigen::VectorXd&, Eigen::MatrixXd& J) override {
+    J = Eigen::MatrixXd::Identity(2, 2);
+    return true;
+  }
+};
+
+}  // namespace
+
+TEST(NonlinearSolver, LineSearchTakesOverWhenFullNewtonStepsDiverge) {
+  // Full Newton on atan from a distance of 2: 2 -> -3.54 -> 13.95 -> -279 (diverges).
+  Atan f;
+  f.a = Eigen::Vector2d(0.5, -1.0);
+  Eigen::VectorXd x = f.a + Eigen::Vector2d(2.0, -2.5);
+  SolverOptions opt;
+  opt.tolerance = 1e-12;
+  const SolverOutcome out = solve_nonlinear(f, x, opt);
+  ASSERT_EQ(out.status, SolverStatus::Converged) << out.message;
+  EXPECT_LT((x - f.a).lpNorm<Eigen::Infinity>(), 1e-12);
+  EXPECT_LE(out.residual_history.back(), 1e-12);
+}
+
+TEST(NonlinearSolver, FullNewtonStepsConvergeQuadraticallyFromAFairStart) {
+  Atan f;
+  f.a = Eigen::Vector3d(0.5, -1.0, 2.0);
+  for (Backend b : {Backend::Kinsol, Backend::Nlopt}) {
+    Eigen::VectorXd x = f.a + Eigen::Vector3d(0.3, -0.2, 0.1);
+    SolverOptions opt;
+    opt.backend = b;
+    opt.tolerance = 1e-12;
+    const SolverOutcome out = solve_nonlinear(f, x, opt);
+    ASSERT_EQ(out.status, SolverStatus::Converged) << backend_name(b) << ": " << out.message;
+    EXPECT_LT((x - f.a).lpNorm<Eigen::Infinity>(), 1e-12) << backend_name(b);
+    if (b == Backend::Kinsol) EXPECT_LE(out.iterations, 5);  // |e_{k+1}| ~ |e_k|^3 for atan: 0.3 -> 1e-2 -> 1e-6 -> 1e-18
+  }
+}
+
+TEST(NonlinearSolver, ANoiseFloorAboveTheToleranceIsNotConvergence) {
+  Noisy f;
+  Eigen::VectorXd x = Eigen::Vector2d(1.0, -2.0);
+  SolverOptions opt;
+  opt.tolerance = 1e-10;
+  const SolverOutcome out = solve_nonlinear(f, x, opt);
+  EXPECT_NE(out.status, SolverStatus::Converged);
+  EXPECT_GT(out.residual_norm, 1e-10);
+  EXPECT_LT(out.residual_norm, 1e-6);  // it got down to the floor
+  EXPECT_NE(out.message.find("stalled"), std::string::npos) << out.message;
+  EXPECT_LT(out.iterations, opt.max_iterations) << "a stall is recognised, not iterated to the limit";
+}
