@@ -196,10 +196,14 @@ SolverOutcome solve_kinsol(NonlinearSystem& system, Eigen::VectorXd& x, const So
   } else {
     // Phase 2: line search from the best iterate so far.
     const std::string what = data.aborted ? "diverged after " : data.stalled ? "stalled after " : "did not converge in ";
-    phases = " (full Newton steps " + what + std::to_string(out.iterations) + " iterations; then line search)";
+    phases = " (full Newton steps " + what + std::to_string(out.iterations) + " iterations";
     data.full_steps = false;
     x = data.best_x;
-    if (out.iterations < opt.max_iterations) flag = kinsol_run(data, x, opt, KIN_LINESEARCH, out.iterations);
+    if (out.iterations < opt.max_iterations) {
+      phases += "; then line search";
+      flag = kinsol_run(data, x, opt, KIN_LINESEARCH, out.iterations);
+    }
+    phases += ")";
     if (data.best_norm < INFINITY && !converged(x)) x = data.best_x;  // never return worse than seen
   }
   const bool ok = system.residual(x, data.F) && data.F.allFinite();
