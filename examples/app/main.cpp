@@ -71,6 +71,20 @@ void print_run(const RunRecord& r) {
   if (r.has_physical_momentum)
     std::printf("mechanical momentum drift: max_n |P_n - P_0| = %.3e, P_0 = (%s)\n", r.physical_momentum_drift,
                 join_numbers(r.physical_momentum_initial).c_str());
+  if (r.error_estimate) {
+    const auto& e = *r.error_estimate;
+    std::string cols;
+    for (const auto& c : r.state_columns) cols += (cols.empty() ? "" : ", ") + c;
+    if (!e.failure.empty())
+      std::printf("error estimate: not available: %s\n", e.failure.c_str());
+    else if (e.order_observed)
+      std::printf("error estimate: %.3e, max over %s (observed order %.2f from N = %d, %d, %d)\n", e.value, cols.c_str(),
+                  e.observed_order, r.N, r.N / 2, r.N / 4);
+    else
+      std::printf("error estimate: %.3e, max over %s (no convergence order observed from N = %d, %d, %d: the "
+                  "difference to N/2 is given; refine N)\n",
+                  e.value, cols.c_str(), r.N, r.N / 2, r.N / 4);
+  }
   std::printf("final:");
   for (const auto& [k, v] : r.final_state) std::printf(" %s = %.10g", k.c_str(), v);
   std::printf("\nwall time: %.3f s\n", r.wall_time_s);

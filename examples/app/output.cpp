@@ -211,6 +211,18 @@ Written write_run(const Scene& scene, const RunRecord& r, const std::string& dir
   }
   if (!r.constraints.empty()) j["constraints"] = r.constraints;
   j["tolerance"] = r.tolerance;
+  if (r.error_estimate) {
+    const auto& e = *r.error_estimate;
+    if (!e.failure.empty())
+      j["error_estimate"] = {{"value", nullptr}, {"failure", e.failure}};
+    else
+      j["error_estimate"] = {{"value", e.value},
+                             {"observed_order", e.order_observed ? json(e.observed_order) : json(nullptr)},
+                             {"grids", {r.N, r.N / 2, r.N / 4}},
+                             {"differences", {e.d_fine, e.d_coarse}},
+                             {"columns", r.state_columns},
+                             {"wall_time_s", e.wall_time_s}};
+  }
   if (!r.continuation_parameter.empty())
     j["continuation"] = {{"parameter", "parameters." + r.continuation_parameter},
                          {"path", r.continuation_path},

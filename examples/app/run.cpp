@@ -1,6 +1,10 @@
 // Which runner a command and a scene call for.
 #include "run.hpp"
 
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
 namespace lpshoot::app {
 
 std::string check_boundary(const Scene& s) {
@@ -19,7 +23,62 @@ std::string check_boundary(const Scene& s) {
   return "";
 }
 
+namespace {
+
+RunRecord run_one(const std::string& command, const Scene& s, const Progress& progress);
+
+// max over the state columns of |a - b| at the nodes of b's grid (every `stride`-th node of a).
+double max_difference(const RunRecord& a, const RunRecord& b, int stride) {
+  double d = 0;
+  for (const auto& name : a.state_columns) {
+    const int ia = a.trajectory.index(name), ib = b.trajectory.index(name);
+    for (size_t n = 0; n < b.trajectory.rows(); ++n)
+      d = std::max(d, std::abs(a.trajectory.columns[ia][n * stride] - b.trajectory.columns[ib][n]));
+  }
+  return d;
+}
+
+// Richardson from three grids N, N/2, N/4: d_fine = |x_N - x_{N/2}|, d_coarse = |x_{N/2} - x_{N/4}|;
+// with an error c h^p, d_coarse / d_fine = 2^p and the error of x_N is d_fine / (2^p - 1).
+void estimate_error(const Scene& s, RunRecord& r, const Progress& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<RunRecord> coarse;
+  for (int f : {2, 4}) {
+    Scene c = s;
+    c.N = s.N / f;
+    c.error_estimate = false;
+    c.shooting.segments = c.auto_segments ? auto_segments(c.N, c.order())
+                                          : std::clamp(s.shooting.segments / f, 1, c.N - 2 * c.order() + 1);
+    if (progress) progress("error estimate: solving on N = " + std::to_string(c.N));
+    coarse.push_back(run_one("solve", c, Progress()));
+    if (!coarse.back().converged) {  // the run itself stands; only its estimate is missing
+      RunRecord::ErrorEstimate e;
+      e.failure = "the solve on N = " + std::to_string(c.N) + " did not converge (" + coarse.back().message + ")";
+      r.error_estimate = e;
+      return;
+    }
+  }
+  RunRecord::ErrorEstimate e;
+  e.d_fine = max_difference(r, coarse[0], 2);
+  e.d_coarse = max_difference(coarse[0], coarse[1], 2);
+  e.observed_order = e.d_fine > 0 && e.d_coarse > 0 ? std::log2(e.d_coarse / e.d_fine) : 0;
+  e.order_observed = e.observed_order > 0.5;
+  e.value = e.order_observed ? e.d_fine / (std::pow(2.0, e.observed_order) - 1) : e.d_fine;
+  e.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.error_estimate = e;
+}
+
+}  // namespace
+
 RunRecord run_scene(const std::string& command, const Scene& s, const Progress& progress) {
+  RunRecord r = run_one(command, s, progress);
+  if (s.error_estimate && r.converged) estimate_error(s, r, progress);
+  return r;
+}
+
+namespace {
+
+RunRecord run_one(const std::string& command, const Scene& s, const Progress& progress) {
   if (command == "simulate") {
     if (s.problem != ProblemKind::BeanieFree)
       throw SceneError(s.file + ": problem: \"" + s.problem_name +
@@ -34,5 +93,7 @@ RunRecord run_scene(const std::string& command, const Scene& s, const Progress& 
   }
   return {};
 }
+
+}  // namespace
 
 }  // namespace lpshoot::app

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -61,6 +62,17 @@ struct RunRecord {
   std::string continuation_parameter;
   std::vector<double> continuation_path;
   int continuation_solves = 0;
+  // scheme.error_estimate: the run's error estimated from the same problem on N/2 and N/4
+  // (Richardson with the observed order), max over state_columns at the common nodes.
+  struct ErrorEstimate {
+    double value = 0;                  // estimated max error of this run's state columns
+    double observed_order = 0;         // log2(d_coarse / d_fine)
+    double d_fine = 0, d_coarse = 0;   // max |x_N - x_{N/2}|, max |x_{N/2} - x_{N/4}|
+    bool order_observed = false;       // false: value is d_fine itself (no asymptotic order seen)
+    double wall_time_s = 0;            // of the two extra solves
+    std::string failure;               // non-empty: a coarse solve failed, no estimate
+  };
+  std::optional<ErrorEstimate> error_estimate;
   std::vector<std::pair<std::string, double>> final_state;
   Table trajectory;                        // first column t
   Table momentum;                          // t, J1.., J_drift (, P1.., P_drift) when has_momentum

@@ -433,8 +433,13 @@ Scene parse_scene(const json& j, const std::string& path) {
     if (s.problem == ProblemKind::BeanieFree) {
       sc->allow({});
     } else {
-      sc->allow(s.problem == ProblemKind::Beanie ? std::vector<std::string>{"closure", "constraints"}
-                                                 : std::vector<std::string>{"closure"});
+      sc->allow(s.problem == ProblemKind::Beanie ? std::vector<std::string>{"closure", "constraints", "error_estimate"}
+                                                 : std::vector<std::string>{"closure", "error_estimate"});
+      s.error_estimate = sc->boolean("error_estimate", false);
+      if (s.error_estimate && (s.N % 4 != 0 || s.N / 4 < 2 * k + 1))
+        sc->fail("needs N divisible by 4 with N/4 >= 2k + 1 = " + std::to_string(2 * k + 1) +
+                     " (the estimate solves on N/2 and N/4 too; N = " + std::to_string(s.N) + ")",
+                 "error_estimate");
       s.closure = sc->choice("closure", {"paper", "second_order"}, "second_order") == "paper" ? Closure::Paper
                                                                                                : Closure::SecondOrder;
       if (s.problem == ProblemKind::Beanie)

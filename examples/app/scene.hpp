@@ -38,7 +38,8 @@ struct Scene {
   Closure closure = Closure::SecondOrder;
   problems::BeanieConstraints constraints = problems::BeanieConstraints::ExactRotation;
   ShootingOptions shooting;
-  bool auto_segments = true;  // solver.segments "auto" (the default): see auto_segments()
+  bool auto_segments = true;
+  bool error_estimate = false;  // scheme.error_estimate: also solve on N/2 and N/4 (run.cpp)  // solver.segments "auto" (the default): see auto_segments()
 
   // solver.continuation: solve at parameters.<parameter> = from first, then step towards the
   // scene's own value, each solve starting from the last solution (shooting/continuation.hpp).

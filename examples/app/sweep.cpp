@@ -57,6 +57,7 @@ SweepRecord run_sweep(const Scene& scene, const std::string& command, const Swee
     for (int N : grids) {
       Scene s = scene;
       s.N = N;
+      s.error_estimate = false;  // the sweep measures errors itself
       SweepRun sr;
       sr.N = N;
       sr.h = s.h();

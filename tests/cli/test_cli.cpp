@@ -258,6 +258,44 @@ TEST(Continuation, StiffPotentialIsReachedFromTheFreeProblem) {
     EXPECT_NEAR(cont["final_state"][key].get<double>(), single["final_state"][key].get<double>(), 1e-8) << key;
 }
 
+TEST(ErrorEstimate, ElectronEstimateMatchesTheTrueError) {
+  // Richardson from N, N/2, N/4 against the exact continuous optimum (matrix exponential).
+  const fs::path work = scratch("estimate");
+  for (int N : {200, 400}) {
+    const fs::path out = work / std::to_string(N);
+    const Outcome o = run_cli("solve '" + scene("electron") + "' --no-plot --set scheme.error_estimate=true --set horizon.N=" +
+                                  std::to_string(N) + " --out '" + out.string() + "'", work);
+    ASSERT_EQ(o.code, 0) << o.out << o.err;
+    EXPECT_NE(o.out.find("error estimate: "), std::string::npos) << o.out;
+    const json report = json::parse(std::ifstream(out / "report.json"));
+    std::vector<std::string> header;
+    const auto rows = read_csv(out / "trajectory.csv", header);
+    lpshoot::problems::Electron e;
+    const auto exact = lpshoot::problems::electron_exact_optimum(e, 2.0, {1.0, 0.0, 0.5}, {0.0, 1.0, 0.0},
+                                                                 {0.0, 1.0, -0.5}, {-1.0, 0.0, 0.2});
+    double err = 0;
+    for (const auto& r : rows) err = std::max(err, (Eigen::Vector3d(r[1], r[2], r[3]) - exact.position(r[0])).lpNorm<Eigen::Infinity>());
+    const double estimate = report["error_estimate"]["value"].get<double>();
+    std::printf("N = %d: true error %.3e, estimate %.3e, observed order %.3f\n", N, err, estimate,
+                report["error_estimate"]["observed_order"].get<double>());
+    EXPECT_NEAR(estimate / err, 1.0, 0.1);
+    EXPECT_NEAR(report["error_estimate"]["observed_order"].get<double>(), 2.0, 0.1);
+  }
+}
+
+TEST(ErrorEstimate, ObservedOrderFollowsTheClosure) {
+  // The paper's closure q_1 = q_0 + h q'(0) caps the beanie's BVP at first order (METHOD.md §5).
+  const fs::path work = scratch("estimate_order");
+  for (const auto& [closure, order] : {std::pair<std::string, double>{"second_order", 2.0}, {"paper", 1.0}}) {
+    const fs::path out = work / closure;
+    const Outcome o = run_cli("solve '" + scene("beanie") + "' --no-plot --set scheme.error_estimate=true --set scheme.closure=" +
+                                  closure + " --out '" + out.string() + "'", work);
+    ASSERT_EQ(o.code, 0) << o.out << o.err;
+    const json report = json::parse(std::ifstream(out / "report.json"));
+    EXPECT_NEAR(report["error_estimate"]["observed_order"].get<double>(), order, 0.15) << closure;
+  }
+}
+
 TEST(Sweep, ElectronOrdersAgainstTheExactOptimum) {
   const fs::path work = scratch("sweep_electron");
   for (const std::string closure : {"second_order", "paper"}) {
@@ -354,6 +392,8 @@ TEST_F(BadInput, EachClassFailsCleanlyNamingTheKey) {
       {"segments", "solve " + e + "--set solver.segments=0", "solver.segments: must be between 1 and"},
       {"tolerance", "solve " + e + "--set solver.tolerance=-1", "solver.tolerance: must be > 0"},
       {"tolerance_below_roundoff", "solve " + e + "--set solver.tolerance=1e-16", "solver.tolerance: must be between 1e-14"},
+      {"error_estimate_grid", "solve " + b + "--set scheme.error_estimate=true --set horizon.N=202",
+       "scheme.error_estimate: needs N divisible by 4"},
       {"segments_word", "solve " + e + "--set solver.segments=many", "solver.segments: must be an integer or \"auto\""},
       {"continuation_unknown_parameter",
        "solve " + e + "--set 'solver.continuation={\"parameter\": \"mass\", \"from\": 1}'",
