@@ -312,7 +312,27 @@ class ShootingSystem : public NonlinearSystem {
   }
 
  private:
+  // The conditions (unscaled) at x, with their Jacobian when J is given. The last evaluation is
+  // kept: the solver asks again for what the setup (row tolerances) already computed at the guess.
   bool evaluate(const Eigen::VectorXd& x, Eigen::VectorXd& F, Eigen::MatrixXd* J) {
+    const bool same_x = memo_x_.size() == x.size() && memo_x_ == x;
+    if (same_x && (!J || memo_has_J_)) {
+      if (!memo_ok_) return false;
+      F = memo_F_;
+      if (J) *J = memo_J_;
+      return true;
+    }
+    memo_x_ = x;
+    memo_has_J_ = J != nullptr;
+    memo_ok_ = evaluate_uncached(x, F, J);
+    if (memo_ok_) {
+      memo_F_ = F;
+      if (J) memo_J_ = *J;
+    }
+    return memo_ok_;
+  }
+
+  bool evaluate_uncached(const Eigen::VectorXd& x, Eigen::VectorXd& F, Eigen::MatrixXd* J) {
     std::vector<FlowResult<P>> runs;
     std::vector<BoundaryState<P>> starts;
     std::vector<Eigen::MatrixXd> Jr;
@@ -402,6 +422,9 @@ class ShootingSystem : public NonlinearSystem {
   std::string last_failure_;
   Eigen::MatrixXd M_, Minv_;
   Eigen::VectorXd w_;
+  Eigen::VectorXd memo_x_, memo_F_;
+  Eigen::MatrixXd memo_J_;
+  bool memo_has_J_ = false, memo_ok_ = false;
 };
 
 }  // namespace detail
