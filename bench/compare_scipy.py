@@ -5,8 +5,8 @@ solve_bvp, measured in the same run on the same machine.
 The continuous optimum is linear: y = (x, x', u, u') solves y' = A y, so the exact answer is
 expm(A t) y0 (computed here with scipy.linalg.expm, independently of lpshoot's C++ oracle).
 scipy solve_bvp (4th-order collocation) solves that 12-dimensional two-point problem directly;
-lpshoot solves the discrete variational problem (multiple shooting, 25 steps per segment,
-second-order closure) through `lpshoot sweep`, whose errors are against lpshoot's own exact
+lpshoot solves the discrete variational problem (multiple shooting,
+second-order closure, the default segments of at most 100 steps) through `lpshoot sweep`, whose errors are against lpshoot's own exact
 oracle; one lpshoot trajectory is cross-checked here against the Python oracle.
 
 usage: /usr/bin/python3 bench/compare_scipy.py [path/to/lpshoot] [repetitions]
@@ -79,7 +79,7 @@ def lpshoot_sweep(grids):
     runs = {}
     with tempfile.TemporaryDirectory() as out:
         for _ in range(REPS):
-            subprocess.run([LPSHOOT, "sweep", SCENE, "--N", ",".join(map(str, grids)), "--steps-per-segment", "25",
+            subprocess.run([LPSHOOT, "sweep", SCENE, "--N", ",".join(map(str, grids)), "--set", "solver.segments=auto",
                             "--no-plot", "--quiet", "--out", out], check=True, capture_output=True)
             with open(os.path.join(out, "sweep.json")) as f:
                 for r in json.load(f)["runs"]:
@@ -95,6 +95,26 @@ def lpshoot_sweep(grids):
     return rows, cross
 
 
+def lpshoot_richardson(grids):
+    """lpshoot solve with scheme.error_estimate: the extrapolated trajectory (N, N/2, N/4 solves);
+    time = the run's wall time plus the estimate's, error against this script's oracle."""
+    rows = []
+    with tempfile.TemporaryDirectory() as out:
+        for N in grids:
+            times, err = [], None
+            for _ in range(REPS):
+                subprocess.run([LPSHOOT, "solve", SCENE, "--set", f"horizon.N={N}", "--set", "solver.segments=auto",
+                                "--set", "scheme.error_estimate=true", "--no-plot", "--quiet", "--out", out],
+                               check=True, capture_output=True)
+                with open(os.path.join(out, "report.json")) as f:
+                    r = json.load(f)
+                times.append(r["wall_time_s"] + r["error_estimate"]["wall_time_s"])
+                data = np.genfromtxt(os.path.join(out, "trajectory_extrapolated.csv"), delimiter=",", names=True)
+                err = np.max(np.abs(np.stack([data["x1"], data["x2"], data["x3"]], 1) - exact_x(data["t"])))
+            rows.append((N, err, statistics.median(times)))
+    return rows
+
+
 def main():
     print(f"electron scene {os.path.relpath(SCENE)}, T = {T}; median of {REPS} runs; error = max |x - x_exact|\n")
     sc = [(tol,) + scipy_run(tol) for tol in [1e-3, 1e-4, 1e-5, 1e-6, 1e-8]]
@@ -105,6 +125,9 @@ def main():
         print(f"| scipy solve_bvp | tol {tol:g} ({nodes} nodes) | {ok} | {err:.2e} | {1e3 * t:.2f} |")
     for N, ok, err, t in ls:
         print(f"| lpshoot (multiple, 2nd-order closure) | N = {N} | {ok} | {err:.2e} | {1e3 * t:.2f} |")
+    rich = lpshoot_richardson([100, 200, 400, 800])
+    for N, err, t in rich:
+        print(f"| lpshoot + Richardson (error_estimate) | N = {N} (and N/2, N/4) | True | {err:.2e} | {1e3 * t:.2f} |")
     print(f"\ncross-check: lpshoot N = 200 against this script's expm oracle: {cross:.2e}")
 
     # Time to reach an error level (log-log interpolation along each method's curve).
@@ -118,12 +141,15 @@ def main():
 
     sp = [(err, t) for _, ok, err, t, _ in sc if ok]
     lp = [(err, t) for _, ok, err, t in ls if ok]
-    print("\n| error level | scipy solve_bvp [ms] | lpshoot [ms] | lpshoot / scipy |")
-    print("|---|---|---|---|")
-    for level in [1e-3, 1e-4, 1e-5]:
-        a, b = time_for(sp, level), time_for(lp, level)
-        ratio = f"{b / a:.2f}" if a and b else "n/a (outside a curve)"
-        print(f"| {level:g} | {a * 1e3 if a else float('nan'):.2f} | {b * 1e3 if b else float('nan'):.2f} | {ratio} |")
+    lr = [(err, t) for _, err, t in rich]
+    fmt = lambda x: f"{x * 1e3:.2f}" if x else "-"
+    ratio = lambda b, a: f"{b / a:.2f}" if a and b else "n/a"
+    print("\n| error level | scipy solve_bvp [ms] | lpshoot [ms] | lpshoot + Richardson [ms] | lpshoot / scipy | Richardson / scipy |")
+    print("|---|---|---|---|---|---|")
+    for level in [1e-4, 1e-5, 1e-6, 1e-7]:
+        a, b, c = time_for(sp, level), time_for(lp, level), time_for(lr, level)
+        print(f"| {level:g} | {fmt(a)} | {fmt(b)} | {fmt(c)} | {ratio(b, a)} | {ratio(c, a)} |")
+    print("(times interpolated log-log along each curve; '-': the level is outside that curve)")
 
 
 if __name__ == "__main__":

@@ -78,8 +78,8 @@ void print_run(const RunRecord& r) {
     if (!e.failure.empty())
       std::printf("error estimate: not available: %s\n", e.failure.c_str());
     else if (e.order_observed)
-      std::printf("error estimate: %.3e, max over %s (observed order %.2f from N = %d, %d, %d)\n", e.value, cols.c_str(),
-                  e.observed_order, r.N, r.N / 2, r.N / 4);
+      std::printf("error estimate: %.3e, max over %s (observed order %.2f from N = %d, %d, %d; %.3f s more)\n", e.value,
+                  cols.c_str(), e.observed_order, r.N, r.N / 2, r.N / 4, e.wall_time_s);
     else
       std::printf("error estimate: %.3e, max over %s (no convergence order observed from N = %d, %d, %d: the "
                   "difference to N/2 is given; refine N)\n",

@@ -170,10 +170,17 @@ Written write_run(const Scene& scene, const RunRecord& r, const std::string& dir
   const fs::path dir(dir_name);
   ensure_dir(dir);
   Written w;
-  const std::vector<std::string> results = {"trajectory.csv", "momentum.csv", "trajectory.png", "momentum.png", "plot.gp"};
+  const std::vector<std::string> results = {"trajectory.csv", "trajectory_extrapolated.csv", "momentum.csv",
+                                            "trajectory.png", "momentum.png", "plot.gp"};
   if (r.converged) {
     write_atomic(dir, "trajectory.csv", csv(r.trajectory));
     w.files.push_back((dir / "trajectory.csv").string());
+    if (r.error_estimate && r.error_estimate->extrapolation_order > 0) {
+      write_atomic(dir, "trajectory_extrapolated.csv", csv(r.error_estimate->extrapolated));
+      w.files.push_back((dir / "trajectory_extrapolated.csv").string());
+    } else {
+      remove_stale(dir, {"trajectory_extrapolated.csv"});
+    }
     if (r.has_momentum) {
       write_atomic(dir, "momentum.csv", csv(r.momentum));
       w.files.push_back((dir / "momentum.csv").string());
@@ -221,6 +228,7 @@ Written write_run(const Scene& scene, const RunRecord& r, const std::string& dir
                              {"grids", {r.N, r.N / 2, r.N / 4}},
                              {"differences", {e.d_fine, e.d_coarse}},
                              {"columns", r.state_columns},
+                             {"extrapolation_order", e.extrapolation_order},
                              {"wall_time_s", e.wall_time_s}};
   }
   if (!r.continuation_parameter.empty())

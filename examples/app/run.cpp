@@ -64,6 +64,19 @@ void estimate_error(const Scene& s, RunRecord& r, const Progress& progress) {
   e.observed_order = e.d_fine > 0 && e.d_coarse > 0 ? std::log2(e.d_coarse / e.d_fine) : 0;
   e.order_observed = e.observed_order > 0.5;
   e.value = e.order_observed ? e.d_fine / (std::pow(2.0, e.observed_order) - 1) : e.d_fine;
+  if (std::abs(e.observed_order - std::round(e.observed_order)) < 0.25 && std::round(e.observed_order) >= 1) {
+    e.extrapolation_order = static_cast<int>(std::round(e.observed_order));
+    const double factor = 1.0 / (std::pow(2.0, e.extrapolation_order) - 1);
+    const RunRecord& half = coarse[0];
+    e.extrapolated.add("t", half.trajectory.columns[0]);
+    for (const auto& name : r.state_columns) {
+      const auto& fine = r.trajectory.columns[r.trajectory.index(name)];
+      const auto& c = half.trajectory.columns[half.trajectory.index(name)];
+      std::vector<double> x(c.size());
+      for (size_t n = 0; n < c.size(); ++n) x[n] = fine[2 * n] + factor * (fine[2 * n] - c[n]);
+      e.extrapolated.add(name, x);
+    }
+  }
   e.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.error_estimate = e;
 }

@@ -71,6 +71,10 @@ struct RunRecord {
     bool order_observed = false;       // false: value is d_fine itself (no asymptotic order seen)
     double wall_time_s = 0;            // of the two extra solves
     std::string failure;               // non-empty: a coarse solve failed, no estimate
+    // Richardson extrapolation x_N + (x_N - x_{N/2}) / (2^p - 1) at the N/2 nodes, with p the
+    // observed order rounded to an integer (0: not within 0.25 of one, no extrapolation).
+    int extrapolation_order = 0;
+    Table extrapolated;                // t and the state columns
   };
   std::optional<ErrorEstimate> error_estimate;
   std::vector<std::pair<std::string, double>> final_state;

@@ -280,6 +280,16 @@ TEST(ErrorEstimate, ElectronEstimateMatchesTheTrueError) {
                 report["error_estimate"]["observed_order"].get<double>());
     EXPECT_NEAR(estimate / err, 1.0, 0.1);
     EXPECT_NEAR(report["error_estimate"]["observed_order"].get<double>(), 2.0, 0.1);
+    // The extrapolated trajectory (order 2 eliminated) at the N/2 nodes: the next error term is
+    // O(h^3) (the control U_n is a one-sided stencil), far below the run's own O(h^2) error.
+    EXPECT_EQ(report["error_estimate"]["extrapolation_order"], 2);
+    const auto extra = read_csv(out / "trajectory_extrapolated.csv", header);
+    EXPECT_EQ(header, (std::vector<std::string>{"t", "x1", "x2", "x3"}));
+    EXPECT_EQ(extra.size(), static_cast<size_t>(N / 2 + 1));
+    double xerr = 0;
+    for (const auto& r : extra) xerr = std::max(xerr, (Eigen::Vector3d(r[1], r[2], r[3]) - exact.position(r[0])).lpNorm<Eigen::Infinity>());
+    std::printf("N = %d: extrapolated error %.3e\n", N, xerr);
+    EXPECT_LT(xerr, err / 100);
   }
 }
 
