@@ -25,9 +25,18 @@ namespace lpshoot {
 
 enum class ShootingMethod { Single, Multiple };
 
+// Multiple shooting: where segments 1, 2, ... start. Guess: the guess's states there. Propagated:
+// the end of the previous segment run from its start (a forward sweep from the guess's initial
+// state): the continuity defects vanish and the first Newton step is single shooting's. Auto:
+// from the guess, and when that does not converge, again from the sweep (the sweep wins when the
+// guess's interior states are far from the dynamics, e.g. a stiff potential; the guess when the
+// flow is unstable or the guess is a near solution, e.g. a resampled one).
+enum class SegmentStarts { Guess, Propagated, Auto };
+
 struct ShootingOptions {
   ShootingMethod method = ShootingMethod::Single;
   int segments = 4;  // multiple shooting
+  SegmentStarts segment_starts = SegmentStarts::Auto;
   SolverOptions solver;
   NewtonOptions step;
   double rank_tolerance = 1e-10;  // singular values of the equilibrated Jacobian below this times the largest count as zero
@@ -55,6 +64,7 @@ struct ShootingResult {
   std::vector<GroupElement<P, double>> g;  // reconstructed g_0 .. g_N
   double cost = 0;                         // Σ L_d(a_n)
   double momentum_drift = 0;               // relative max |J_n - J_{k-1}|
+  bool propagated_starts = false;          // multiple shooting started from the forward sweep
   bool ok() const { return status == ShootingStatus::Converged; }
 };
 
@@ -436,13 +446,31 @@ struct ShootingGuess {
   GroupElement<P, double> g0 = P::Group::template identity<double>();
 };
 
-// Solves the boundary value problem from a guess (e.g. interpolation of the boundary data, a
-// previous solution resampled to this grid).
+namespace detail {
+
+// Segment starts by a forward sweep: segment i+1 begins where segment i, run from its start,
+// ends (stops at the first segment whose flow fails, keeping the given starts from there on).
 template <class P>
-ShootingResult<P> solve_bvp(const BoundaryValueProblem<P>& bvp, const ShootingGuess<P>& guess,
-                            const ShootingOptions& opt = {}) {
+std::vector<BoundaryState<P>> forward_sweep(const BoundaryValueProblem<P>& bvp, std::vector<BoundaryState<P>> refs,
+                                            const std::vector<int>& starts, const NewtonOptions& step) {
+  constexpr int k = P::order;
+  const DiscreteFlow<P> flow(bvp.problem, bvp.h(), step);
+  for (size_t i = 0; i + 1 < refs.size(); ++i) {
+    const int N_local = starts[i + 1] - starts[i] + 2 * k - 1;
+    const auto run = flow.run(refs[i].s, N_local, nullptr, refs[i].g);
+    if (!run.report.ok()) break;
+    refs[i + 1] = {run.trajectory.state(N_local - k + 1), run.g_first};
+  }
+  return refs;
+}
+
+// One shooting solve from the given segment start states (the unknowns start at 0).
+template <class P>
+ShootingResult<P> solve_from_starts(const BoundaryValueProblem<P>& bvp, const std::vector<BoundaryState<P>>& refs,
+                                    const std::vector<int>& starts, const ShootingOptions& opt) {
   using G = typename P::Group;
   constexpr int k = P::order;
+  const int S = static_cast<int>(refs.size());
   const auto t0 = std::chrono::steady_clock::now();
   ShootingResult<P> out;
   auto finish = [&](ShootingStatus st, std::string msg) {
@@ -451,19 +479,7 @@ ShootingResult<P> solve_bvp(const BoundaryValueProblem<P>& bvp, const ShootingGu
     out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return out;
   };
-  if (const std::string why = check_counting(bvp); !why.empty()) return finish(ShootingStatus::InvalidProblem, why);
-  if (guess.trajectory.N() != bvp.N || static_cast<int>(guess.trajectory.lam.size()) != bvp.N - k + 1)
-    return finish(ShootingStatus::InvalidProblem, "the initial guess has N = " + std::to_string(guess.trajectory.N()) +
-                                                      ", the problem N = " + std::to_string(bvp.N));
-  // Segment starts (state indices) and reference states from the guess.
-  const int first = k, last = bvp.N - k + 1;
-  const int S = opt.method == ShootingMethod::Single ? 1 : std::max(1, std::min(opt.segments, last - first));
-  std::vector<int> starts;
-  for (int i = 0; i <= S; ++i) starts.push_back(first + static_cast<int>(std::lround(double(last - first) * i / S)));
-  const auto g = reconstruct_group(bvp.problem, guess.trajectory, guess.g0);
-  std::vector<BoundaryState<P>> refs;
-  for (int i = 0; i < S; ++i) refs.push_back({guess.trajectory.state(starts[i]), g[starts[i] - k]});
-  detail::ShootingSystem<P> system(bvp, refs, starts, opt.step, opt.threads);
+  ShootingSystem<P> system(bvp, refs, starts, opt.step, opt.threads);
   out.unknowns = system.size();
 
   Eigen::VectorXd x = Eigen::VectorXd::Zero(system.size());
@@ -551,7 +567,10 @@ ShootingResult<P> solve_bvp(const BoundaryValueProblem<P>& bvp, const ShootingGu
   // A solver that ran away from the guess leaves a Jacobian whose rank says nothing about the data.
   const bool diverged = so.status != SolverStatus::Converged && !so.residual_history.empty() &&
                         !(out.residual_norm <= so.residual_history.front());
-  if (out.rank < out.unknowns && !diverged) {
+  // Nor does one where the flow has blown up (conditions off by more than 1e3 in their own units,
+  // e.g. a stiff potential from a poor guess): that is a failure to converge, whatever the rank.
+  const bool far = so.status != SolverStatus::Converged && !(out.raw_residual_norm <= 1e3);
+  if (out.rank < out.unknowns && !diverged && !far) {
     std::string msg = "the shooting Jacobian is rank deficient (rank " + std::to_string(out.rank) + " of " +
                       std::to_string(out.unknowns) +
                       "): redundant or inconsistent boundary data, or a discrete problem that is (nearly) singular at "
@@ -577,10 +596,66 @@ ShootingResult<P> solve_bvp(const BoundaryValueProblem<P>& bvp, const ShootingGu
       msg += "; it stalled close to the tolerance after a " + format_residual(so.residual_history.front() / out.residual_norm) +
              "-fold reduction: the roundoff floor of the flow on this grid (h = " + format_residual(bvp.h()) + ", " +
              std::to_string(longest) + " steps per segment): use shorter segments or a looser tolerance";
+    } else if (!so.residual_history.empty()) {
+      msg += "; the residual went from " + format_residual(so.residual_history.front()) + " at the guess to " +
+             format_residual(out.residual_norm) +
+             ": the guess is too far for Newton's method; try a better guess, more segments, or continuation "
+             "in a parameter from an easier problem";
+      if (out.rank < out.unknowns)
+        msg += " (the Jacobian there has rank " + std::to_string(out.rank) + " of " + std::to_string(out.unknowns) + ")";
     }
     return finish(ShootingStatus::NotConverged, msg);
   }
   return finish(ShootingStatus::Converged, "");
+}
+
+}  // namespace detail
+
+// Solves the boundary value problem from a guess (e.g. interpolation of the boundary data, a
+// previous solution resampled to this grid).
+template <class P>
+ShootingResult<P> solve_bvp(const BoundaryValueProblem<P>& bvp, const ShootingGuess<P>& guess,
+                            const ShootingOptions& opt = {}) {
+  constexpr int k = P::order;
+  const auto t0 = std::chrono::steady_clock::now();
+  auto invalid = [&](std::string msg) {
+    ShootingResult<P> out;
+    out.status = ShootingStatus::InvalidProblem;
+    out.message = std::move(msg);
+    return out;
+  };
+  if (const std::string why = check_counting(bvp); !why.empty()) return invalid(why);
+  if (guess.trajectory.N() != bvp.N || static_cast<int>(guess.trajectory.lam.size()) != bvp.N - k + 1)
+    return invalid("the initial guess has N = " + std::to_string(guess.trajectory.N()) + ", the problem N = " +
+                   std::to_string(bvp.N));
+  // Segment starts (state indices) and reference states from the guess.
+  const int first = k, last = bvp.N - k + 1;
+  const int S = opt.method == ShootingMethod::Single ? 1 : std::max(1, std::min(opt.segments, last - first));
+  std::vector<int> starts;
+  for (int i = 0; i <= S; ++i) starts.push_back(first + static_cast<int>(std::lround(double(last - first) * i / S)));
+  const auto g = reconstruct_group(bvp.problem, guess.trajectory, guess.g0);
+  std::vector<BoundaryState<P>> refs;
+  for (int i = 0; i < S; ++i) refs.push_back({guess.trajectory.state(starts[i]), g[starts[i] - k]});
+
+  const bool sweep_first = S > 1 && opt.segment_starts == SegmentStarts::Propagated;
+  ShootingResult<P> out =
+      detail::solve_from_starts(bvp, sweep_first ? detail::forward_sweep(bvp, refs, starts, opt.step) : refs, starts, opt);
+  out.propagated_starts = sweep_first;
+  // Auto: when the guess's interior states did not lead to a solution, the forward sweep's may
+  // (a stiff potential: the guess is far from the dynamics; an unstable flow: the sweep is not).
+  if (S > 1 && opt.segment_starts == SegmentStarts::Auto && out.status == ShootingStatus::NotConverged) {
+    ShootingResult<P> swept = detail::solve_from_starts(bvp, detail::forward_sweep(bvp, refs, starts, opt.step), starts, opt);
+    swept.propagated_starts = true;
+    swept.iterations += out.iterations;
+    if (swept.ok() || (swept.status == ShootingStatus::NotConverged && swept.residual_norm < out.residual_norm)) {
+      swept.message = swept.ok() ? "" : swept.message + " (from the guess's segment starts as well: " + out.message + ")";
+      out = std::move(swept);
+    } else {
+      out.message += " (from the forward sweep's segment starts as well: " + swept.message + ")";
+    }
+  }
+  out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
 }
 
 inline const char* status_name(ShootingStatus s) {

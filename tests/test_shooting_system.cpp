@@ -157,3 +157,51 @@ TEST(ShootingSystem, ManySegmentsConvergeLikeFewOnANonlinearProblem) {
   for (int n = 0; n <= 200; ++n) diff = std::max(diff, std::abs(a.trajectory.p[n](0) - c.trajectory.p[n](0)));
   EXPECT_LT(diff, 1e-8);
 }
+
+TEST(ShootingSystem, SegmentStartsFromTheForwardSweepWhereTheGuessIsFarFromTheDynamics) {
+  // V = 100 (1 - cos ψ): the interpolated guess's interior states are far from the optimal
+  // (oscillatory, ω ≈ 17) dynamics; started there, multiple shooting fails. Started from the
+  // forward sweep (segment i+1 begins where segment i, run from the guess's start, ends) the
+  // first Newton step is single shooting's, and it converges to single shooting's optimum.
+  BeanieControl b;
+  b.par = {1.0, 1.0, 0.5, 100.0};
+  BeanieBoundary s, e;
+  s.psi = 0, s.psi_dot = 0, s.theta = 0, s.x = 0, s.y = 0, s.Omega1 = 0.5, s.Omega2 = 0.2;
+  e.psi = 1.0, e.psi_dot = 0, e.theta = 1.0;
+  const auto bvp = beanie_bvp(b, 2.0, 200, s, e, Closure::SecondOrder);
+  const auto guess = beanie_guess(bvp, s, e);
+  ShootingOptions single, opt;
+  const auto ref = solve_bvp(bvp, guess, single);
+  ASSERT_TRUE(ref.ok()) << ref.message;
+  opt.method = ShootingMethod::Multiple;
+  opt.segments = 4;
+  opt.segment_starts = SegmentStarts::Guess;
+  const auto from_guess = solve_bvp(bvp, guess, opt);
+  EXPECT_FALSE(from_guess.ok());
+  for (SegmentStarts starts : {SegmentStarts::Propagated, SegmentStarts::Auto}) {
+    opt.segment_starts = starts;
+    const auto r = solve_bvp(bvp, guess, opt);
+    ASSERT_TRUE(r.ok()) << r.message;
+    EXPECT_TRUE(r.propagated_starts);
+    double diff = 0;
+    for (int n = 0; n <= 200; ++n) diff = std::max(diff, std::abs(r.trajectory.p[n](0) - ref.trajectory.p[n](0)));
+    std::printf("stiff beanie: %s starts, %d iterations (single shooting %d), max |Δψ| %.2e\n",
+                starts == SegmentStarts::Auto ? "auto" : "propagated", r.iterations, ref.iterations, diff);
+    EXPECT_LT(diff, 1e-8);
+    EXPECT_NEAR(r.cost, ref.cost, 1e-9 * ref.cost);
+  }
+}
+
+TEST(ShootingSystem, AutomaticSegmentStartsKeepTheGuessWhenTheFlowIsUnstable) {
+  // φ = -|x|^2, T = 12: a forward sweep grows like e^{1.4 t}; the guess's states are kept.
+  const Electron e{1.0, 1.0, Eigen::Vector3d(0, 0, 1.0), -1.0};
+  const ElectronBoundary start{Eigen::Vector3d(1.0, 0.0, 0.5), Eigen::Vector3d(0.0, 1.0, 0.0)};
+  const ElectronBoundary end{Eigen::Vector3d(0.0, 1.0, -0.5), Eigen::Vector3d(-1.0, 0.0, 0.2)};
+  const auto bvp = electron_bvp(e, 12.0, 1200, start, end, Closure::SecondOrder);
+  ShootingOptions opt;
+  opt.method = ShootingMethod::Multiple;
+  opt.segments = 24;
+  const auto r = solve_bvp(bvp, electron_guess(bvp, start, end), opt);
+  ASSERT_TRUE(r.ok()) << r.message;
+  EXPECT_FALSE(r.propagated_starts);
+}

@@ -210,6 +210,7 @@ Written write_run(const Scene& scene, const RunRecord& r, const std::string& dir
   if (!r.method.empty()) {
     j["method"] = r.method;
     j["segments"] = r.segments;
+    if (r.segments > 1) j["segment_starts"] = r.propagated_starts ? "forward sweep" : "guess";
     j["backend"] = r.backend;
     j["closure"] = r.closure;
   } else {

@@ -38,6 +38,7 @@ struct RunRecord {
   double T = 0, h = 0;
   std::string method, backend, closure, constraints;  // empty when not applicable
   int segments = 1;
+  bool propagated_starts = false;  // multiple shooting began from the forward sweep (SegmentStarts)
   double tolerance = 0;
   bool has_cost = false;  // optimal control: ½ Σ h |u_n|^2
   double cost = 0;

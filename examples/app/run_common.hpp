@@ -93,6 +93,7 @@ void record_outcome(const ShootingResult<P>& res, RunRecord& r) {
                  std::to_string(r.continuation_path.size()) + " values solved in " +
                  std::to_string(r.continuation_solves) + " solves)";
   r.iterations = res.iterations;
+  r.propagated_starts = res.propagated_starts;
   r.residual_norm = res.residual_norm;
   r.raw_residual_norm = res.raw_residual_norm;
   r.condition = res.condition;
