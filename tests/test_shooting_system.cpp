@@ -133,17 +133,25 @@ TEST(ShootingSystem, LinearProblemJacobianStaysExactOnFineGrids) {
   EXPECT_LE(r.iterations, 3) << "a linear problem: one Newton step, plus roundoff";
 }
 
+namespace {
+// The beanie scene's problem (examples/scenes/beanie.json, N = 200) with V = amplitude (1 - cos ψ).
+std::pair<BoundaryValueProblem<BeanieControl>, ShootingGuess<BeanieControl>> scene_beanie(double amplitude) {
+  BeanieControl b;
+  b.par = {1.0, 1.0, 0.5, amplitude};
+  BeanieBoundary s, e;
+  s.psi = 0, s.psi_dot = 0, s.theta = 0, s.x = 0, s.y = 0, s.Omega1 = 0.5, s.Omega2 = 0.2;
+  e.psi = 1.0, e.psi_dot = 0, e.theta = 1.0;
+  auto bvp = beanie_bvp(b, 2.0, 200, s, e, Closure::SecondOrder);
+  auto guess = beanie_guess(bvp, s, e);
+  return {std::move(bvp), std::move(guess)};
+}
+}  // namespace
+
 TEST(ShootingSystem, ManySegmentsConvergeLikeFewOnANonlinearProblem) {
   // Beanie with V = 1 - cos ψ (nonlinear): the Newton step does not depend on the row scaling,
   // but a line search's merit does; with rows scaled by tolerances spanning 1e4 the line search
   // once took 19 iterations at 50 segments against 3 at 4. Full steps come first now.
-  BeanieControl b;
-  b.par = {1.0, 1.0, 0.5, 1.0};
-  BeanieBoundary s, e;
-  s.psi = 0, s.psi_dot = 0, s.theta = 0, s.x = 0, s.y = 0, s.Omega1 = 0.5, s.Omega2 = 0.2;
-  e.psi = 1.0, e.psi_dot = 0, e.theta = 1.0;
-  const auto bvp = beanie_bvp(b, 2.0, 200, s, e, Closure::SecondOrder);
-  const auto guess = beanie_guess(bvp, s, e);
+  const auto [bvp, guess] = scene_beanie(1.0);
   ShootingOptions few, many;
   few.method = many.method = ShootingMethod::Multiple;
   few.segments = 4;
@@ -163,13 +171,7 @@ TEST(ShootingSystem, SegmentStartsFromTheForwardSweepWhereTheGuessIsFarFromTheDy
   // (oscillatory, ω ≈ 17) dynamics; started there, multiple shooting fails. Started from the
   // forward sweep (segment i+1 begins where segment i, run from the guess's start, ends) the
   // first Newton step is single shooting's, and it converges to single shooting's optimum.
-  BeanieControl b;
-  b.par = {1.0, 1.0, 0.5, 100.0};
-  BeanieBoundary s, e;
-  s.psi = 0, s.psi_dot = 0, s.theta = 0, s.x = 0, s.y = 0, s.Omega1 = 0.5, s.Omega2 = 0.2;
-  e.psi = 1.0, e.psi_dot = 0, e.theta = 1.0;
-  const auto bvp = beanie_bvp(b, 2.0, 200, s, e, Closure::SecondOrder);
-  const auto guess = beanie_guess(bvp, s, e);
+  const auto [bvp, guess] = scene_beanie(100.0);
   ShootingOptions single, opt;
   const auto ref = solve_bvp(bvp, guess, single);
   ASSERT_TRUE(ref.ok()) << ref.message;
