@@ -25,7 +25,21 @@ std::string check_boundary(const Scene& s) {
 
 namespace {
 
-RunRecord run_one(const std::string& command, const Scene& s, const Progress& progress);
+RunRecord run_one(const std::string& command, const Scene& s, const Progress& progress) {
+  if (command == "simulate") {
+    if (s.problem != ProblemKind::BeanieFree)
+      throw SceneError(s.file + ": problem: \"" + s.problem_name +
+                       "\" is an optimal control problem (a boundary value problem): run `lpshoot solve` on it");
+    return simulate_beanie_free(s, progress);
+  }
+  switch (s.problem) {
+    case ProblemKind::Electron: return solve_electron(s, progress);
+    case ProblemKind::Beanie: return solve_beanie(s, progress);
+    case ProblemKind::BeanieFree:
+      throw SceneError(s.file + ": problem: \"beanie_free\" is a simulation from initial data: run `lpshoot simulate` on it");
+  }
+  return {};
+}
 
 // max over the state columns of |a - b| at the nodes of b's grid (every `stride`-th node of a).
 double max_difference(const RunRecord& a, const RunRecord& b, int stride) {
@@ -88,25 +102,5 @@ RunRecord run_scene(const std::string& command, const Scene& s, const Progress& 
   if (s.error_estimate && r.converged) estimate_error(s, r, progress);
   return r;
 }
-
-namespace {
-
-RunRecord run_one(const std::string& command, const Scene& s, const Progress& progress) {
-  if (command == "simulate") {
-    if (s.problem != ProblemKind::BeanieFree)
-      throw SceneError(s.file + ": problem: \"" + s.problem_name +
-                       "\" is an optimal control problem (a boundary value problem): run `lpshoot solve` on it");
-    return simulate_beanie_free(s, progress);
-  }
-  switch (s.problem) {
-    case ProblemKind::Electron: return solve_electron(s, progress);
-    case ProblemKind::Beanie: return solve_beanie(s, progress);
-    case ProblemKind::BeanieFree:
-      throw SceneError(s.file + ": problem: \"beanie_free\" is a simulation from initial data: run `lpshoot simulate` on it");
-  }
-  return {};
-}
-
-}  // namespace
 
 }  // namespace lpshoot::app
