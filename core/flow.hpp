@@ -42,21 +42,6 @@ struct Trajectory {
   }
 };
 
-enum class FlowStatus { Ok, NotConverged, Singular, NonFinite, InvalidInput };
-
-struct FlowReport {
-  FlowStatus status = FlowStatus::Ok;
-  std::string message;      // empty when Ok; names the failed step otherwise
-  int failed_step = -1;
-  int steps = 0;            // steps completed
-  int total_iterations = 0;
-  int max_iterations = 0;
-  double max_residual = 0;
-  double max_condition = 0;
-  std::vector<StepReport> step_reports;  // one per attempted step
-  bool ok() const { return status == FlowStatus::Ok; }
-};
-
 template <class P>
 struct FlowResult {
   Trajectory<P> trajectory;  // up to the last completed step
@@ -137,27 +122,13 @@ class DiscreteFlow {
     tr.p.reserve(N + 1);
     tr.g.reserve(N);
     tr.lam.reserve(N - k + 1);
-    rep.step_reports.reserve(std::max(0, N - 2 * k + 1));
     if (seed) out.sensitivity = *seed;
 
     FlowState<P> s = initial;
     Eigen::MatrixXd next;
     for (int n = k; n <= N - k; ++n) {
       StepUnknowns<P> z;
-      StepReport sr = solve_step(problem_, h_, s, n, options_, z);
-      rep.step_reports.push_back(sr);
-      rep.total_iterations += sr.iterations;
-      rep.max_iterations = std::max(rep.max_iterations, sr.iterations);
-      rep.max_residual = std::max(rep.max_residual, sr.residual);
-      rep.max_condition = std::max(rep.max_condition, sr.condition);
-      if (sr.status != StepStatus::Converged) {
-        rep.status = sr.status == StepStatus::Singular    ? FlowStatus::Singular
-                     : sr.status == StepStatus::NonFinite ? FlowStatus::NonFinite
-                                                          : FlowStatus::NotConverged;
-        rep.message = sr.message;
-        rep.failed_step = n;
-        return out;
-      }
+      if (!rep.add(solve_step(problem_, h_, s, n, options_, z))) return out;
       if (seed) {
         // New state = shifted old state + z; the new rows come from the implicit function theorem.
         const Eigen::Matrix<double, D::unknowns, ns> dz = step_sensitivity(problem_, h_, s, z);
@@ -193,7 +164,6 @@ class DiscreteFlow {
       tr.p.push_back(z.p);
       tr.g.push_back(z.g);
       tr.lam.push_back(z.lam);
-      ++rep.steps;
     }
     return out;
   }

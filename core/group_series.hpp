@@ -35,10 +35,11 @@ T alternating_series(const T& w, int shift) {
       series_coefficient(6, 1), series_coefficient(7, 1), series_coefficient(8, 1),
       series_coefficient(9, 1)};
   const double* c = shift == 0 ? c0 : c1;
-  // Terms kept so that the first omitted one, and its first two derivatives, are below 1e-17
-  // (the nested duals carry at most second derivatives): at w = 0 two terms are exact.
+  // Terms kept so that the first omitted one, and its first four derivatives, are below 1e-17
+  // relative (nested duals carry second derivatives, and a Taylor2 of them two more): at w = 0
+  // three terms are exact to the fourth derivative.
   const double a = std::abs(value(w));
-  const int terms = a < 1e-8 ? 2 : a < 1e-3 ? 4 : a < 0.05 ? 6 : 10;
+  const int terms = a < 1e-8 ? 3 : a < 1e-3 ? 4 : a < 0.05 ? 6 : 10;
   const T w2 = w * w;
   T acc = T(c[terms - 1]);
   for (int j = terms - 2; j >= 0; --j) acc = acc * w2 + c[j];

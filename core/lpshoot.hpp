@@ -1,8 +1,10 @@
-// The lpshoot core: Lie groups, the problem contract, the derived discrete constrained
-// higher-order Lagrange–Poincaré equations, the discrete flow map and momentum.
+// The lpshoot core: Lie groups, the problem contracts (a discrete L_d for the paper's windows, or a
+// continuous ℓ for the Galerkin schemes), the derived discrete constrained higher-order
+// Lagrange–Poincaré equations, the discrete flow maps and momentum.
 #pragma once
 
 #include "flow.hpp"
+#include "galerkin_flow.hpp"
 #include "groups.hpp"
 #include "local_action.hpp"
 #include "momentum.hpp"

@@ -8,11 +8,8 @@
 #pragma once
 
 #include "local_action.hpp"
+#include "newton.hpp"
 
-#include <Eigen/LU>
-
-#include <cstdio>
-#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -42,25 +39,6 @@ struct StepUnknowns {
   Vec<double, P::shape_dim> p;      // p_{n+k}
   GroupElement<P, double> g;        // g~_{n+k-1}
   Vec<double, P::num_constraints> lam;  // λ^n
-};
-
-enum class StepStatus { Converged, NotConverged, Singular, NonFinite };
-
-struct StepReport {
-  int step = -1;  // n
-  StepStatus status = StepStatus::NotConverged;
-  int iterations = 0;
-  double residual = 0;   // max-norm of F at the last evaluation
-  double condition = 0;  // 1-norm condition number of ∂F/∂z at the last evaluation
-  std::string message;   // empty when converged
-};
-
-struct NewtonOptions {
-  int max_iterations = 20;
-  // Converged when every Newton correction satisfies |dz_i| <= step_tolerance * (1 + |z_i|).
-  double step_tolerance = 1e-12;
-  // A step whose ∂F/∂z has a larger condition estimate is reported singular.
-  double max_condition = 1e13;
 };
 
 // The step's node block (nodes n-k .. n+k) in scalar T. With T a Dual, the unknowns z are seeded
@@ -159,47 +137,8 @@ void apply_correction(StepUnknowns<P>& z, const Vec<double, Dims<P>::unknowns>& 
   z.lam += dz.template tail<D::m>();
 }
 
-// Short numeric text for messages ("1.2e+16").
-inline std::string format_number(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", x);
-  return buf;
-}
-
-// ||J||_1 ||J^{-1}||_1 from the LU factors (exact, cheap at these sizes); inf or NaN if singular.
-// J^{-1} e_j by plain substitutions: P J = L U, so J^{-1} e_j = U^{-1} L^{-1} P e_j.
-template <class M, class LU>
-double condition_number_1(const M& J, const LU& lu) {
-  constexpr int n = M::RowsAtCompileTime;
-  const M& f = lu.matrixLU();
-  const auto perm = lu.permutationP().indices();
-  double inv_norm = 0;
-  for (int j = 0; j < n; ++j) {
-    double x[n > 0 ? n : 1];
-    for (int i = 0; i < n; ++i) x[i] = perm(j) == i ? 1.0 : 0.0;
-    for (int i = 0; i < n; ++i)
-      for (int c = 0; c < i; ++c) x[i] -= f(i, c) * x[c];
-    double col = 0;
-    for (int i = n - 1; i >= 0; --i) {
-      for (int c = i + 1; c < n; ++c) x[i] -= f(i, c) * x[c];
-      x[i] /= f(i, i);
-      col += std::abs(x[i]);
-    }
-    if (!(col <= inv_norm)) inv_norm = col;  // keeps a NaN from a zero pivot
-  }
-  return J.cwiseAbs().colwise().sum().maxCoeff() * inv_norm;
-}
-
-inline bool all_finite(const double* x, int n) {
-  for (int i = 0; i < n; ++i)
-    if (!std::isfinite(x[i])) return false;
-  return true;
-}
-
-// Solves step n by Newton from the predictor (linear extrapolation of p, previous increment and
-// multiplier). The z-independent windows are evaluated once; after a Newton step, chord steps
-// (same factorization, residual only) are taken while they contract by 4x, else the Jacobian is
-// refreshed. No allocation in the loop (everything is fixed size) except the failure message.
+// Solves step n by Newton (newton.hpp) from the predictor (linear extrapolation of p, previous
+// increment and multiplier). The z-independent windows are evaluated once per step.
 template <class P>
 StepReport solve_step(const P& problem, double h, const FlowState<P>& s, int n, const NewtonOptions& opt,
                       StepUnknowns<P>& z) {
@@ -208,56 +147,28 @@ StepReport solve_step(const P& problem, double h, const FlowState<P>& s, int n, 
   z.p = 2.0 * s.p[2 * k - 1] - s.p[2 * k - 2];
   z.g = s.g[2 * k - 2];
   if constexpr (D::m > 0) z.lam = s.lam[k - 1];
-
-  StepReport rep;
-  rep.step = n;
-  auto fail = [&](StepStatus st, const std::string& why) {
-    rep.status = st;
-    rep.message = "step n=" + std::to_string(n) + ": " + why;
-    return rep;
-  };
   const Vec<double, D::node> fixed = step_fixed_part(problem, h, s, z);
-  if (!all_finite(fixed.data(), D::node))
-    return fail(StepStatus::NonFinite, "the step equations evaluated to a non-finite number");
-  Vec<double, nz> F;
-  Eigen::Matrix<double, nz, nz> J;
-  Eigen::PartialPivLU<Eigen::Matrix<double, nz, nz>> lu;
-  bool refresh = true;
-  double last_step = std::numeric_limits<double>::infinity();
-  for (int it = 1; it <= opt.max_iterations; ++it) {
-    rep.iterations = it;
-    if (refresh) {
-      evaluate_step<P, nz>(problem, h, s, z, false, &fixed, F, J);
-      if (!all_finite(F.data(), nz) || !all_finite(J.data(), nz * nz))
-        return fail(StepStatus::NonFinite, "the step equations evaluated to a non-finite number");
-      lu.compute(J);
-      rep.condition = condition_number_1(J, lu);
-      if (!(rep.condition <= opt.max_condition))
-        return fail(StepStatus::Singular, "the step matrix (Proposition 2) is singular (condition " +
-                                              format_number(rep.condition) + " > " +
-                                              format_number(opt.max_condition) + ")");
-    } else {
-      F = step_residual(problem, h, s, z, fixed);
-      if (!all_finite(F.data(), nz))
-        return fail(StepStatus::NonFinite, "the step equations evaluated to a non-finite number");
-    }
-    rep.residual = F.template lpNorm<Eigen::Infinity>();
-    const Vec<double, nz> dz = lu.solve(-F);
-    Vec<double, nz> scale;
-    scale.template head<D::r>() = z.p.cwiseAbs();
-    scale.template segment<D::d>(D::r).setZero();
-    scale.template tail<D::m>() = z.lam.cwiseAbs();
-    apply_correction(z, dz);
-    if (((dz.cwiseAbs().array() - opt.step_tolerance * (1.0 + scale.array())) <= 0.0).all()) {
-      rep.status = StepStatus::Converged;
-      return rep;
-    }
-    const double step = dz.template lpNorm<Eigen::Infinity>();
-    refresh = refresh ? false : !(step <= 0.25 * last_step);  // after a chord step that contracts too slowly
-    last_step = step;
+  if (!all_finite(fixed.data(), D::node)) {
+    StepReport rep;
+    rep.step = n;
+    rep.status = StepStatus::NonFinite;
+    rep.message = "step n=" + std::to_string(n) + ": the step equations evaluated to a non-finite number";
+    return rep;
   }
-  return fail(StepStatus::NotConverged, "Newton did not converge in " + std::to_string(opt.max_iterations) +
-                                            " iterations (residual " + format_number(rep.residual) + ")");
+  return newton_solve<nz>(
+      n, opt,
+      [&](Vec<double, nz>& F, Eigen::Matrix<double, nz, nz>& J) {
+        evaluate_step<P, nz>(problem, h, s, z, false, &fixed, F, J);
+      },
+      [&](Vec<double, nz>& F) { F = step_residual(problem, h, s, z, fixed); },
+      [&](const Vec<double, nz>& dz) { apply_correction(z, dz); },
+      [&] {
+        Vec<double, nz> scale;
+        scale.template head<D::r>() = z.p.cwiseAbs();
+        scale.template segment<D::d>(D::r).setZero();
+        scale.template tail<D::m>() = z.lam.cwiseAbs();
+        return scale;
+      });
 }
 
 // dz/d(state) at a solved step (nz x state), by the implicit function theorem.

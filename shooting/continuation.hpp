@@ -42,11 +42,46 @@ ShootingGuess<P> resample(const ShootingResult<P>& from, int N) {
   return guess;
 }
 
+// The same on a Galerkin trajectory: node data interpolated linearly, increments rescaled to
+// the new step (X2, V1, O1 and bubbles are derivative-like: kept), W = exp(ratio log W_old),
+// multipliers interpolated.
+template <class C, int S, int Q>
+GalerkinGuess<Galerkin<C, S, Q>> resample(const ShootingResult<Galerkin<C, S, Q>>& from, int N) {
+  using Sch = Galerkin<C, S, Q>;
+  using G = typename Sch::Group;
+  const GalerkinTrajectory<Sch>& old = from.trajectory;
+  const double T = old.N() * old.h, h = T / N, ratio = h / old.h;
+  GalerkinGuess<Sch> guess;
+  GalerkinTrajectory<Sch>& tr = guess.trajectory;
+  tr.h = h;
+  tr.g0 = old.g0;
+  for (int n = 0; n < N; ++n) {
+    const double s = std::clamp(n * h / old.h, 0.0, double(old.N()));
+    const int i = std::min(static_cast<int>(s), old.N() - 1);
+    const double w = s - i;
+    Interval<Sch, double> iv = old.intervals[i];
+    iv.x = (1 - w) * old.x(i) + w * old.x(i + 1);
+    iv.v = (1 - w) * old.v(i) + w * old.v(i + 1);
+    iv.Om = (1 - w) * old.Omega(i) + w * old.Omega(i + 1);
+    if constexpr (Sch::d > 0)
+      iv.W = G::template exp<double>(typename G::template Tangent<double>(ratio * G::log(old.intervals[i].W)));
+    tr.intervals.push_back(iv);
+  }
+  return guess;
+}
+
 template <class P>
 ShootingGuess<P> as_guess(const ShootingResult<P>& r) {
   ShootingGuess<P> g;
   g.trajectory = r.trajectory;
   g.g0 = r.g.front();
+  return g;
+}
+
+template <class C, int S, int Q>
+GalerkinGuess<Galerkin<C, S, Q>> as_guess(const ShootingResult<Galerkin<C, S, Q>>& r) {
+  GalerkinGuess<Galerkin<C, S, Q>> g;
+  g.trajectory = r.trajectory;
   return g;
 }
 
@@ -70,8 +105,8 @@ struct ContinuationResult {
 // Solves make(s) for s from `from` to `to`, each solve starting from the previous solution; a
 // failed step is halved, a success lets the step grow by 1.5.
 template <class P>
-ContinuationResult<P> continuation(const std::function<BoundaryValueProblem<P>(double)>& make, double from, double to,
-                                   const ShootingGuess<P>& guess, const ShootingOptions& opt = {},
+ContinuationResult<P> continuation(const std::function<typename SchemeFor<P>::BVP(double)>& make, double from, double to,
+                                   const typename SchemeFor<P>::Guess& guess, const ShootingOptions& opt = {},
                                    const ContinuationOptions& copt = {}) {
   ContinuationResult<P> out;
   const double span = to - from;

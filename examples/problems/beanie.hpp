@@ -130,6 +130,41 @@ struct BeanieControl {
   }
 };
 
+// The continuous optimal control (METHOD.md §6.2, §9) for the Galerkin schemes: ℓ = ½ u² with
+// u = μ ψ'' + V'(ψ); the free beanie's group equations as constraints on Ω = ξ + (0, 0, c ψ'),
+//   χ = (Ω1' - w Ω2, Ω2' + w Ω1, Ω3'),  w = Ω3 - c ψ' = θ'
+// (Ω12 turns against θ: the spatial velocity R(θ) Ω12 is constant), and the connection
+// form 𝒜 = (0, 0, c).
+struct BeanieModel {
+  using Group = SE2;
+  static constexpr int shape_dim = 1;
+  static constexpr int num_constraints = 3;
+  BeanieParameters par;
+
+  template <class T>
+  T control(const Jet<BeanieModel, T>& q) const {
+    return par.mu() * q.ddp(0) + par.dV(q.p(0));
+  }
+  template <class T>
+  T lagrangian(const Jet<BeanieModel, T>& q) const {
+    const T u = control(q);
+    return 0.5 * u * u;
+  }
+  template <class T>
+  Vec<T, 3> constraints(const Jet<BeanieModel, T>& q) const {
+    const T w = q.Omega(2) - par.c() * q.dp(0);
+    Vec<T, 3> chi;
+    chi(0) = q.dOmega(0) - w * q.Omega(1);
+    chi(1) = q.dOmega(1) + w * q.Omega(0);
+    chi(2) = q.dOmega(2);
+    return chi;
+  }
+  template <class T>
+  Eigen::Matrix<T, 3, 1> connection_form(const Vec<T, 1>&) const {
+    return Eigen::Matrix<T, 3, 1>(T(0.0), T(0.0), T(par.c()));
+  }
+};
+
 }  // namespace lpshoot::problems
 
 extern template class lpshoot::DiscreteFlow<lpshoot::problems::BeanieFree>;

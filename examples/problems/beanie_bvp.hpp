@@ -93,4 +93,93 @@ inline ShootingGuess<BeanieControl> beanie_guess(const BoundaryValueProblem<Bean
   return guess;
 }
 
+// The same problem for a Galerkin scheme of degree S (order 2S - 2): every quantity is node data
+// (ψ, ψ' the node's shape and velocity, Ω1..3 its reduced group velocity, θ, x, y its group
+// element), imposed exactly; a missing one gets its natural condition.
+template <int S>
+using BeanieGalerkin = Galerkin<BeanieModel, S>;
+
+template <int S>
+GalerkinBVP<BeanieGalerkin<S>> beanie_galerkin_bvp(const BeanieModel& model, double T, int N, const BeanieBoundary& start,
+                                                   const BeanieBoundary& end) {
+  using B = GalerkinBVP<BeanieGalerkin<S>>;
+  B bvp{model, N, T, {}};
+  for (End e : {End::Initial, End::Terminal}) {
+    const BeanieBoundary& d = e == End::Initial ? start : end;
+    const std::string side = e == End::Initial ? "initial " : "terminal ";
+    if (d.psi_dot && !d.psi) throw std::invalid_argument(side + "psi_dot is given without psi");
+    auto value = [&](const std::optional<double>& q, int component, const std::string& name) {
+      if (q)
+        bvp.fix(e, component, *q, side + name);
+      else
+        bvp.natural(e, component, side + name + " (natural)");
+    };
+    value(d.psi, B::x_component(0), "psi");
+    value(d.psi_dot, B::v_component(0), "psi_dot");
+    value(d.Omega1, B::Omega_component(0), "Omega1");
+    value(d.Omega2, B::Omega_component(1), "Omega2");
+    value(d.Omega3, B::Omega_component(2), "Omega3");
+    const SE2::Element<double> g{d.theta.value_or(0.0), Eigen::Vector2d(d.x.value_or(0.0), d.y.value_or(0.0))};
+    const std::optional<double> gq[3] = {d.x, d.y, d.theta};
+    const char* gname[3] = {"x", "y", "theta"};
+    for (int i = 0; i < 3; ++i) {
+      if (gq[i])
+        bvp.fix_group(e, i, g, side + gname[i]);
+      else
+        bvp.natural(e, B::g_component(i), side + gname[i] + " (natural)");
+    }
+  }
+  return bvp;
+}
+
+// Guess: ψ by cubic Hermite interpolation (as beanie_guess); Ω3 constant (given, or the value that
+// reaches θ(T)); the group motion of the free beanie on that ψ: θ = θ0 + Ω3 t - c (ψ - ψ0), the
+// centre moving uniformly with the spatial velocity R(θ0) Ω12(0), Ω12 = R(-(θ - θ0)) Ω12(0); zero
+// bubbles and multipliers.
+template <int S>
+GalerkinGuess<BeanieGalerkin<S>> beanie_galerkin_guess(const GalerkinBVP<BeanieGalerkin<S>>& bvp, const BeanieBoundary& start,
+                                                       const BeanieBoundary& end) {
+  const BeanieParameters& par = bvp.model.par;
+  const double h = bvp.h(), T = bvp.T, c = par.c();
+  const double psi0 = start.psi.value_or(end.psi.value_or(0.0)), psiT = end.psi.value_or(psi0);
+  const double v0 = start.psi_dot.value_or(0.0), vT = end.psi_dot.value_or(0.0);
+  auto psi = [&](double t, int k) {
+    const double s = t / T;
+    if (k == 0)
+      return (2 * s * s * s - 3 * s * s + 1) * psi0 + (s * s * s - 2 * s * s + s) * T * v0 + (-2 * s * s * s + 3 * s * s) * psiT +
+             (s * s * s - s * s) * T * vT;
+    return ((6 * s * s - 6 * s) * psi0 + (3 * s * s - 4 * s + 1) * T * v0 + (-6 * s * s + 6 * s) * psiT + (3 * s * s - 2 * s) * T * vT) / T;
+  };
+  double Omega3 = start.Omega3.value_or(0.0);
+  if (!start.Omega3 && start.theta && end.theta) Omega3 = (*end.theta - *start.theta + c * (psiT - psi0)) / T;
+  const Eigen::Vector2d Om12(start.Omega1.value_or(0.0), start.Omega2.value_or(0.0));
+  const double theta0 = start.theta.value_or(0.0);
+  const Eigen::Vector2d r0(start.x.value_or(0.0), start.y.value_or(0.0));
+  auto group = [&](double t) -> SE2::Element<double> {
+    const double theta = theta0 + Omega3 * t - c * (psi(t, 0) - psi0);
+    return {theta, Eigen::Vector2d(r0 + t * SO2::rotation(theta0) * Om12)};
+  };
+  GalerkinGuess<BeanieGalerkin<S>> guess;
+  auto& tr = guess.trajectory;
+  tr.h = h;
+  tr.g0 = group(0);
+  for (int n = 0; n < bvp.N; ++n) {
+    const double t0 = n * h, t1 = (n + 1) * h;
+    Interval<BeanieGalerkin<S>, double> iv;
+    iv.x(0) = psi(t0, 0);
+    iv.v(0) = psi(t0, 1);
+    iv.X2(0) = (psi(t1, 0) - iv.x(0) - h * iv.v(0)) / (h * h);
+    iv.V1(0) = (psi(t1, 1) - iv.v(0)) / h;
+    const double dtheta0 = group(t0).angle - theta0, dtheta1 = group(t1).angle - theta0;
+    iv.Om << SO2::rotation(-dtheta0) * Om12, Omega3;
+    Eigen::Vector3d end_Om;
+    end_Om << SO2::rotation(-dtheta1) * Om12, Omega3;
+    iv.O1 = (end_Om - iv.Om) / h;
+    iv.W = SE2::compose(SE2::inverse(group(t0)), group(t1));
+    iv.w.setZero();
+    tr.intervals.push_back(iv);
+  }
+  return guess;
+}
+
 }  // namespace lpshoot::problems

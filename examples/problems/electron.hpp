@@ -37,6 +37,41 @@ struct Electron {
   }
 };
 
+// The continuous problem (METHOD.md §6.1, §9) for the Galerkin schemes: ℓ = ½ |u|² with
+//   u = m x'' + ∇φ(x) - (e/c) x' × B,  φ(x) = potential |x|² + quartic x1⁴
+// (quartic = 0 is the paper's electron; METHOD.md §9's nonlinear check uses potential = 1/2,
+// quartic = 1/8).
+struct ElectronModel {
+  using Group = Trivial;
+  static constexpr int shape_dim = 3;
+  static constexpr int num_constraints = 0;
+
+  double mass = 1.0;
+  double e_over_c = 1.0;
+  Eigen::Vector3d B = Eigen::Vector3d(0, 0, 1);
+  double potential = 1.0;
+  double quartic = 0.0;
+
+  template <class T>
+  Vec<T, 3> control(const Jet<ElectronModel, T>& q) const {
+    const Vec<T, 3>& x = q.p;
+    const Vec<T, 3>& v = q.dp;
+    Vec<T, 3> vxB;
+    vxB(0) = v(1) * B(2) - v(2) * B(1);
+    vxB(1) = v(2) * B(0) - v(0) * B(2);
+    vxB(2) = v(0) * B(1) - v(1) * B(0);
+    Vec<T, 3> u = mass * q.ddp + (2.0 * potential) * x - e_over_c * vxB;
+    if (quartic != 0.0) u(0) = u(0) + (4.0 * quartic) * x(0) * x(0) * x(0);
+    return u;
+  }
+  template <class T>
+  T lagrangian(const Jet<ElectronModel, T>& q) const {
+    return 0.5 * control(q).squaredNorm();
+  }
+};
+
+inline ElectronModel model_of(const Electron& e) { return {e.mass, e.e_over_c, e.B, e.potential, 0.0}; }
+
 }  // namespace lpshoot::problems
 
 extern template class lpshoot::DiscreteFlow<lpshoot::problems::Electron>;

@@ -1,0 +1,260 @@
+// Galerkin discretizations of a continuous reduced problem (METHOD.md §9): Hermite curves of
+// degree S on node states, Q Gauss–Legendre points, written in increments.
+//
+// Node n carries (x_n, v_n, Ω_n): shape, shape velocity and reduced group velocity; interval n
+// carries scaled increments (X2, V1, O1) with
+//   x_{n+1} = x_n + h v_n + h² X2,  v_{n+1} = v_n + h V1,  Ω_{n+1} = Ω_n + h O1,
+// the group increment W_n = g_n^{-1} g_{n+1}, S - 3 bubble coefficients per shape and group
+// component and m multipliers per Gauss point. On the interval (τ = (t - t_n)/h),
+//   p(τ) = x_n + h v_n τ + h² (X2 H01 + V1 H11 + Σ a_j β_j)            (no nearly-equal nodes)
+//   g(τ) = g_n exp(ξ(τ)),  ξ = h ω_n H10 + log(W_n) H01 + h Jr(log W_n)^{-1} ω_{n+1} H11 + h² Σ c_j β_j
+// with ω = Ω − 𝒜(p) p' the body velocity at the nodes (METHOD.md §9 route (a): ξ Hermite in the
+// algebra, so g is C¹ and L_d depends on g only through W_n: the discrete momentum map is
+// conserved). The discrete Lagrangian is the Gauss quadrature of ℓ plus the constraints at the
+// Gauss points:
+//   L~_n = h Σ_i b_i [ℓ(q(τ_i)) + λ_i · χ(q(τ_i))].
+// Order 2S − 2 with Q = S − 1 points; fewer points leave the step matrix singular.
+#pragma once
+
+#include "continuous.hpp"
+#include "group_jets.hpp"
+#include "hermite.hpp"
+
+namespace lpshoot {
+
+template <class C, int S = 3, int Q = S - 1>
+struct Galerkin {
+  using Model = C;
+  using Group = typename C::Group;
+  static constexpr int r = C::shape_dim, d = Group::dim, m = C::num_constraints;
+  static constexpr int degree = S, gauss = Q, bubbles = S - 3;
+  static constexpr int order = 2 * S - 2;             // with Q = S - 1
+  static constexpr int node = 2 * r + d;               // (x, v, Ω)
+  static constexpr int variation = 2 * r + 2 * d;      // node perturbation (δx, δv, δΩ, η)
+  static constexpr int aux = bubbles * (r + d) + Q * m;  // bubbles, then multipliers
+  static constexpr int unknowns = node + d + aux;      // one step: (X2, V1, O1), ζ, aux
+  static constexpr int state = node + unknowns;        // an interval: base node + its unknowns
+  // Offsets in an interval's tangent coordinates (W is perturbed as W exp(h δ)).
+  static constexpr int x_off = 0, v_off = r, Om_off = 2 * r;
+  static constexpr int X2_off = node, V1_off = node + r, O1_off = node + 2 * r, W_off = 2 * node,
+                       aux_off = 2 * node + d;
+  static constexpr int shape_bubble(int j) { return j * r; }  // within aux
+  static constexpr int group_bubble(int j) { return bubbles * r + j * d; }
+  static constexpr int multipliers(int i) { return bubbles * (r + d) + i * m; }
+  static_assert(S >= 3 && S <= 6, "Galerkin curves of degree 3 (order 4) to 6");
+  static_assert(Q >= 1 && Q <= 5, "1 to 5 Gauss points");
+  static_assert(r >= 1, "the shape space must have dimension at least 1");
+};
+
+// One interval in increment form (see the file comment), in scalar T.
+template <class Sch, class T>
+struct Interval {
+  using G = typename Sch::Group;
+  Vec<T, Sch::r> x, v, X2, V1;
+  Vec<T, Sch::d> Om, O1;
+  typename G::template Element<T> W = G::template identity<T>();
+  Vec<T, Sch::aux> w;
+
+  Vec<T, Sch::r> x_end(double h) const { return x + h * v + (h * h) * X2; }
+  Vec<T, Sch::r> v_end(double h) const { return v + h * V1; }
+  Vec<T, Sch::d> Om_end(double h) const { return Om + h * O1; }
+
+  template <class TO>
+  Interval<Sch, TO> cast() const {
+    Interval<Sch, TO> o;
+    o.x = x.template cast<TO>(), o.v = v.template cast<TO>(), o.X2 = X2.template cast<TO>();
+    o.V1 = V1.template cast<TO>(), o.Om = Om.template cast<TO>(), o.O1 = O1.template cast<TO>();
+    o.W = G::template cast<TO>(W);
+    o.w = w.template cast<TO>();
+    return o;
+  }
+};
+
+// The interval's ξ end data (METHOD.md §9 route (a)): ζ = log W, ω0 and the end slope
+// Jr(ζ)^{-1} ω1 (so that the body velocity of g_n exp(ξ) at the end node is ω1).
+template <class Sch, class T>
+struct GroupCurveEnds {
+  Vec<T, Sch::d> zeta, omega0, omega1;
+};
+
+template <class Sch, class T>
+GroupCurveEnds<Sch, T> group_curve_ends(const typename Sch::Model& model, const Interval<Sch, T>& iv, double h) {
+  using G = typename Sch::Group;
+  GroupCurveEnds<Sch, T> e;
+  e.zeta = G::log(iv.W);
+  e.omega0 = iv.Om - connection_velocity(model, iv.x, iv.v);
+  const Vec<T, Sch::d> end_velocity = iv.Om_end(h) - connection_velocity(model, iv.x_end(h), iv.v_end(h));
+  e.omega1 = solve_small<T, Sch::d>(right_jacobian<G, T>(e.zeta), end_velocity);
+  return e;
+}
+
+// The jet q = (p, p', p'', Ω, Ω') at Gauss point i.
+template <class Sch, class T>
+Jet<typename Sch::Model, T> jet_at(const typename Sch::Model& model, const Interval<Sch, T>& iv,
+                                   const GroupCurveEnds<Sch, T>& ends, int i, double h) {
+  using C = typename Sch::Model;
+  using G = typename Sch::Group;
+  constexpr int r = Sch::r, d = Sch::d;
+  const auto& B = GalerkinTable<Sch::degree, Sch::gauss>::get().basis[i];
+  const double tau = GalerkinTable<Sch::degree, Sch::gauss>::get().c[i];
+  // Shape: the k-th time derivative of h²(X2 H01 + V1 H11 + Σ a_j β_j) is h^(2-k) times this.
+  auto shape_part = [&](int k) {
+    Vec<T, r> s = B[2][k] * iv.X2 + B[3][k] * iv.V1;
+    if constexpr (Sch::bubbles > 0)
+      for (int j = 0; j < Sch::bubbles; ++j) s += B[4 + j][k] * iv.w.template segment<r>(Sch::shape_bubble(j));
+    return s;
+  };
+  Jet<C, T> q;
+  q.p = iv.x + (h * tau) * iv.v + (h * h) * shape_part(0);
+  q.dp = iv.v + h * shape_part(1);
+  q.ddp = shape_part(2);
+  if constexpr (d > 0) {
+    using TT = Taylor2<T>;
+    // ξ(t_i + s) to second order in s (time units): ξ, ξ_τ / h, ξ_ττ / (2 h²).
+    auto xi_part = [&](int k) {
+      Vec<T, d> s = (h * B[1][k]) * ends.omega0 + B[2][k] * ends.zeta + (h * B[3][k]) * ends.omega1;
+      if constexpr (Sch::bubbles > 0)
+        for (int j = 0; j < Sch::bubbles; ++j)
+          s += (h * h * B[4 + j][k]) * iv.w.template segment<d>(Sch::group_bubble(j));
+      return s;
+    };
+    const Vec<T, d> x0 = xi_part(0), x1 = xi_part(1), x2 = xi_part(2);
+    typename G::template Tangent<TT> xi;
+    for (int a = 0; a < d; ++a) xi(a) = TT(x0(a), x1(a) / h, x2(a) / (2 * h * h));
+    typename G::template Tangent<T> Omb, dOmb;
+    body_velocity_jet<G, T>(xi, Omb, dOmb);
+    q.Omega = Omb;
+    q.dOmega = dOmb;
+    if constexpr (detail::HasConnectionForm<C, TT>::value) {  // + 𝒜(p) p' and its time derivative
+      const Vec<T, r> dddp = shape_part(3) / h;
+      Vec<TT, r> pT, dpT;
+      for (int a = 0; a < r; ++a) {
+        pT(a) = TT(q.p(a), q.dp(a), 0.5 * q.ddp(a));
+        dpT(a) = TT(q.dp(a), q.ddp(a), 0.5 * dddp(a));
+      }
+      const Vec<TT, d> cv = connection_velocity(model, pT, dpT);
+      for (int a = 0; a < d; ++a) {
+        q.Omega(a) += cv(a).c0;
+        q.dOmega(a) += cv(a).c1;
+      }
+    }
+  }
+  return q;
+}
+
+// L~ of one interval: h Σ_i b_i [ℓ(q_i) + λ_i · χ(q_i)].
+template <class Sch, class T>
+T interval_action(const typename Sch::Model& model, const Interval<Sch, T>& iv, double h) {
+  constexpr int m = Sch::m;
+  const auto& tab = GalerkinTable<Sch::degree, Sch::gauss>::get();
+  GroupCurveEnds<Sch, T> ends;
+  if constexpr (Sch::d > 0) ends = group_curve_ends(model, iv, h);
+  T L(0.0);
+  for (int i = 0; i < Sch::gauss; ++i) {
+    const auto q = jet_at(model, iv, ends, i, h);
+    T li = model.template lagrangian<T>(q);
+    if constexpr (m > 0) {
+      const Vec<T, m> chi = model.template constraints<T>(q);
+      for (int c = 0; c < m; ++c) li = li + iv.w(Sch::multipliers(i) + c) * chi(c);
+    }
+    L = L + (h * tab.b[i]) * li;
+  }
+  return L;
+}
+
+// The cost part of an interval (without the multiplier terms): h Σ_i b_i ℓ(q_i).
+template <class Sch>
+double interval_cost(const typename Sch::Model& model, const Interval<Sch, double>& iv, double h) {
+  const auto& tab = GalerkinTable<Sch::degree, Sch::gauss>::get();
+  GroupCurveEnds<Sch, double> ends;
+  if constexpr (Sch::d > 0) ends = group_curve_ends(model, iv, h);
+  double L = 0;
+  for (int i = 0; i < Sch::gauss; ++i) L += h * tab.b[i] * model.template lagrangian<double>(jet_at(model, iv, ends, i, h));
+  return L;
+}
+
+// E_n: the derivative of L~(left) + L~(right) with respect to node n, divided by h, in scaled
+// node directions e = (e_x, e_v, e_Ω, e_η): δx = h² e_x, δv = h e_v, δΩ = h e_Ω, η = h e_η (so
+// that every row is O(1)). Node n is the end of `left` (interval n-1) and the base of `right`
+// (interval n): left's increments take the perturbation, right's base takes it and right's
+// increments compensate (its end node stays). Either may be null at a boundary: the result is
+// then the natural boundary condition of that end.
+template <class Sch, class TO>
+Vec<TO, Sch::variation> node_residual(const typename Sch::Model& model, const Interval<Sch, TO>* left,
+                                      const Interval<Sch, TO>* right, double h) {
+  using G = typename Sch::Group;
+  constexpr int r = Sch::r, d = Sch::d, nv = Sch::variation;
+  using TI = Dual<TO, nv>;
+  Vec<TI, r> ex, ev;
+  Vec<TI, d> eO;
+  typename G::template Tangent<TI> eta;
+  for (int a = 0; a < r; ++a) {
+    ex(a) = TI::variable(TO(0.0), a);
+    ev(a) = TI::variable(TO(0.0), r + a);
+  }
+  for (int a = 0; a < d; ++a) {
+    eO(a) = TI::variable(TO(0.0), 2 * r + a);
+    eta(a) = TI::variable(TO(0.0), 2 * r + d + a);
+  }
+  TI S(0.0);
+  if (left) {
+    Interval<Sch, TI> l = left->template cast<TI>();
+    l.X2 += ex;
+    l.V1 += ev;
+    if constexpr (d > 0) {
+      l.O1 += eO;
+      const typename G::template Tangent<TI> step = h * eta;
+      l.W = G::compose(l.W, G::template exp<TI>(step));
+    }
+    S = S + interval_action(model, l, h);
+  }
+  if (right) {
+    Interval<Sch, TI> q = right->template cast<TI>();
+    q.x += (h * h) * ex;
+    q.v += h * ev;
+    q.X2 -= ex + ev;
+    q.V1 -= ev;
+    if constexpr (d > 0) {
+      q.Om += h * eO;
+      q.O1 -= eO;
+      const typename G::template Tangent<TI> step = -h * eta;
+      q.W = G::compose(G::template exp<TI>(step), q.W);
+    }
+    S = S + interval_action(model, q, h);
+  }
+  Vec<TO, nv> E;
+  for (int i = 0; i < nv; ++i) E(i) = S.d[i] / h;
+  return E;
+}
+
+// The interval's own equations: ∂L~/∂(bubbles, multipliers), divided by h (the multiplier rows
+// are b_i χ(q_i)).
+template <class Sch, class TO>
+Vec<TO, Sch::aux> aux_residual(const typename Sch::Model& model, const Interval<Sch, TO>& iv, double h) {
+  constexpr int na = Sch::aux;
+  if constexpr (na == 0) {
+    (void)model, (void)iv, (void)h;
+    return Vec<TO, 0>();
+  } else {
+    using TI = Dual<TO, na>;
+    Interval<Sch, TI> q = iv.template cast<TI>();
+    for (int a = 0; a < na; ++a) q.w(a) = TI::variable(iv.w(a), a);
+    const TI S = interval_action(model, q, h);
+    Vec<TO, na> R;
+    for (int i = 0; i < na; ++i) R(i) = S.d[i] / h;
+    return R;
+  }
+}
+
+// The node after an interval: (x, v, Ω) at its end, and the interval that starts there with
+// the given unknowns.
+template <class Sch, class T>
+Interval<Sch, T> next_interval_base(const Interval<Sch, T>& prev, double h) {
+  Interval<Sch, T> n;
+  n.x = prev.x_end(h);
+  n.v = prev.v_end(h);
+  n.Om = prev.Om_end(h);
+  return n;
+}
+
+}  // namespace lpshoot

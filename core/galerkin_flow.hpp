@@ -1,0 +1,242 @@
+// The Galerkin flow map (METHOD.md §9): intervals one after another from a first interval, with
+// the sensitivity of the last one to any seeded directions of the first, and what is read off
+// a trajectory: nodes, the group element, the discrete momentum map, node controls.
+#pragma once
+
+#include "galerkin_step.hpp"
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+namespace lpshoot {
+
+// A Galerkin trajectory on t_n = n h: intervals 0 .. N-1 (each with its base node n) and g_0.
+template <class Sch>
+struct GalerkinTrajectory {
+  using G = typename Sch::Group;
+  double h = 0;
+  std::vector<Interval<Sch, double>> intervals;
+  typename G::template Element<double> g0 = G::template identity<double>();
+
+  int N() const { return static_cast<int>(intervals.size()); }
+  double time(int n) const { return n * h; }
+  Vec<double, Sch::r> x(int n) const { return n < N() ? intervals[n].x : intervals.back().x_end(h); }
+  Vec<double, Sch::r> v(int n) const { return n < N() ? intervals[n].v : intervals.back().v_end(h); }
+  Vec<double, Sch::d> Omega(int n) const { return n < N() ? intervals[n].Om : intervals.back().Om_end(h); }
+  // g_0 .. g_N (g_{n+1} = g_n W_n).
+  std::vector<typename G::template Element<double>> group() const {
+    std::vector<typename G::template Element<double>> g{g0};
+    g.reserve(intervals.size() + 1);
+    for (const auto& iv : intervals) g.push_back(G::compose(g.back(), iv.W));
+    return g;
+  }
+};
+
+template <class Sch>
+struct GalerkinFlowResult {
+  GalerkinTrajectory<Sch> trajectory;  // the start interval and every completed step's
+  FlowReport report;
+  // d(last interval)/d(seeded directions of the first): Sch::state rows, and d more (the group
+  // element at the last interval's base node, right tangent) when the seed had them.
+  Eigen::MatrixXd sensitivity;
+  typename Sch::Group::template Element<double> g_last;  // g at the last interval's base node
+};
+
+template <class Sch>
+class GalerkinFlow {
+ public:
+  using Model = typename Sch::Model;
+  using G = typename Sch::Group;
+  GalerkinFlow(const Model& model, double h, NewtonOptions options = {}) : model_(model), h_(h), options_(options) {}
+
+  const Model& model() const { return model_; }
+  double h() const { return h_; }
+
+  // Takes `steps` steps from interval `start` (whose base node is node `first_node`, for
+  // messages), g at its base node = g_start. `seed` (Sch::state or Sch::state + d rows) gives
+  // the directions whose sensitivity is propagated. With keep = false only the last interval is
+  // kept in the trajectory (memory O(1) in the steps).
+  GalerkinFlowResult<Sch> run(const Interval<Sch, double>& start, int steps, const Eigen::MatrixXd* seed = nullptr,
+                              const typename G::template Element<double>& g_start = G::template identity<double>(),
+                              int first_node = 0, bool keep = true) const {
+    constexpr int r = Sch::r, d = Sch::d, ns = Sch::state, nz = Sch::unknowns;
+    GalerkinFlowResult<Sch> out;
+    out.trajectory.h = h_;
+    out.trajectory.g0 = g_start;
+    out.g_last = g_start;
+    FlowReport& rep = out.report;
+    if (steps < 0 || !(h_ > 0)) {
+      rep.status = FlowStatus::InvalidInput;
+      rep.message = "the flow needs h > 0 and steps >= 0 (got h = " + format_number(h_) + ", steps = " +
+                    std::to_string(steps) + ")";
+      return out;
+    }
+    if (seed && seed->rows() != ns && seed->rows() != ns + d) {
+      rep.status = FlowStatus::InvalidInput;
+      rep.message = "sensitivity seed has " + std::to_string(seed->rows()) + " rows, expected " + std::to_string(ns) +
+                    " or " + std::to_string(ns + d);
+      return out;
+    }
+    const bool with_group = seed && seed->rows() == ns + d;
+    auto& ivs = out.trajectory.intervals;
+    if (keep) ivs.reserve(steps + 1);
+    ivs.push_back(start);
+    if (seed) out.sensitivity = *seed;
+    Eigen::MatrixXd next;
+    Interval<Sch, double> s = start;
+    for (int k = 1; k <= steps; ++k) {
+      Interval<Sch, double> z;
+      if (!rep.add(solve_galerkin_step<Sch>(model_, h_, s, first_node + k, options_, z))) return out;
+      if (seed) {
+        const Eigen::Matrix<double, nz, ns> dz = galerkin_step_sensitivity<Sch>(model_, h_, s, z);
+        const Eigen::MatrixXd& S = out.sensitivity;
+        next.resize(S.rows(), S.cols());
+        // The base node of interval n is the end of interval n-1.
+        const double h = h_;
+        next.middleRows(Sch::x_off, r) =
+            S.middleRows(Sch::x_off, r) + h * S.middleRows(Sch::v_off, r) + (h * h) * S.middleRows(Sch::X2_off, r);
+        next.middleRows(Sch::v_off, r) = S.middleRows(Sch::v_off, r) + h * S.middleRows(Sch::V1_off, r);
+        next.middleRows(Sch::Om_off, d) = S.middleRows(Sch::Om_off, d) + h * S.middleRows(Sch::O1_off, d);
+        next.middleRows(Sch::X2_off, nz).noalias() = dz * S.topRows(ns);
+        if constexpr (d > 0) {
+          if (with_group)  // g_n = g_{n-1} W_{n-1}:  δg_n = Ad_{W^{-1}} δg_{n-1} + h δW
+            next.bottomRows(d) = G::Ad(G::inverse(s.W)) * S.bottomRows(d) + h * S.middleRows(Sch::W_off, d);
+        }
+        out.sensitivity.swap(next);
+      }
+      out.g_last = G::compose(out.g_last, s.W);
+      s = z;
+      if (keep)
+        ivs.push_back(z);
+      else
+        ivs.back() = z;
+    }
+    return out;
+  }
+
+ private:
+  Model model_;
+  double h_;
+  NewtonOptions options_;
+};
+
+// Moves an interval along its tangent coordinates (Galerkin offsets; W <- W exp(h δ)).
+template <class Sch>
+Interval<Sch, double> retract(const Interval<Sch, double>& s, const Vec<double, Sch::state>& delta, double h) {
+  using G = typename Sch::Group;
+  constexpr int r = Sch::r, d = Sch::d;
+  Interval<Sch, double> o = s;
+  o.x += delta.template segment<r>(Sch::x_off);
+  o.v += delta.template segment<r>(Sch::v_off);
+  o.Om += delta.template segment<d>(Sch::Om_off);
+  o.X2 += delta.template segment<r>(Sch::X2_off);
+  o.V1 += delta.template segment<r>(Sch::V1_off);
+  o.O1 += delta.template segment<d>(Sch::O1_off);
+  if constexpr (d > 0) {
+    const typename G::template Tangent<double> step = h * delta.template segment<d>(Sch::W_off);
+    o.W = G::compose(o.W, G::template exp<double>(step));
+  }
+  o.w += delta.template segment<Sch::aux>(Sch::aux_off);
+  return o;
+}
+
+// The δ with retract(b, δ, h) = a.
+template <class Sch>
+Vec<double, Sch::state> state_difference(const Interval<Sch, double>& a, const Interval<Sch, double>& b, double h) {
+  using G = typename Sch::Group;
+  constexpr int r = Sch::r, d = Sch::d;
+  Vec<double, Sch::state> delta;
+  delta.template segment<r>(Sch::x_off) = a.x - b.x;
+  delta.template segment<r>(Sch::v_off) = a.v - b.v;
+  delta.template segment<d>(Sch::Om_off) = a.Om - b.Om;
+  delta.template segment<r>(Sch::X2_off) = a.X2 - b.X2;
+  delta.template segment<r>(Sch::V1_off) = a.V1 - b.V1;
+  delta.template segment<d>(Sch::O1_off) = a.O1 - b.O1;
+  if constexpr (d > 0) delta.template segment<d>(Sch::W_off) = G::log(G::compose(G::inverse(b.W), a.W)) / h;
+  delta.template segment<Sch::aux>(Sch::aux_off) = a.w - b.w;
+  return delta;
+}
+
+// M_n = μ^R_{W_n}(L~_n) = d/dε L~_n(exp(ε ζ) W_n): the body momentum at node n (n = 0..N-1).
+template <class Sch>
+Vec<double, Sch::d> galerkin_body_momentum(const typename Sch::Model& model, const Interval<Sch, double>& iv, double h) {
+  using G = typename Sch::Group;
+  constexpr int d = Sch::d;
+  using T = Dual<double, d>;
+  Interval<Sch, T> q = iv.template cast<T>();
+  typename G::template Tangent<T> eps;
+  for (int a = 0; a < d; ++a) eps(a) = T::variable(0.0, a);
+  q.W = G::compose(G::template exp<T>(eps), q.W);
+  const T L = interval_action(model, q, h);
+  Vec<double, d> M;
+  for (int a = 0; a < d; ++a) M(a) = L.d[a];
+  return M;
+}
+
+// J_n = Ad*_{g_n^{-1}} M_n for n = 0 .. N-1: constant along every discrete solution (L~_n depends
+// on g only through W_n = g_n^{-1} g_{n+1}).
+template <class Sch>
+std::vector<Vec<double, Sch::d>> galerkin_spatial_momentum(const typename Sch::Model& model,
+                                                           const GalerkinTrajectory<Sch>& tr) {
+  using G = typename Sch::Group;
+  const auto g = tr.group();
+  std::vector<Vec<double, Sch::d>> J;
+  J.reserve(tr.intervals.size());
+  for (int n = 0; n < tr.N(); ++n)
+    J.push_back(G::Ad(G::inverse(g[n])).transpose() * galerkin_body_momentum(model, tr.intervals[n], tr.h));
+  return J;
+}
+
+// The momentum conjugate to the node velocity, π_v = ∂L~/∂v_n (from interval n-1; at node 0,
+// -∂L~_0/∂v_0): the Galerkin scheme's discrete Legendre transform, which approximates ∂ℓ/∂p'' at
+// the node to the scheme's order.
+template <class Sch>
+Vec<double, Sch::r> node_velocity_momentum(const typename Sch::Model& model, const GalerkinTrajectory<Sch>& tr, int n) {
+  constexpr int r = Sch::r;
+  if (n == 0) return -node_residual<Sch, double>(model, nullptr, &tr.intervals[0], tr.h).template segment<r>(r);
+  return node_residual<Sch, double>(model, &tr.intervals[n - 1], nullptr, tr.h).template segment<r>(r);
+}
+
+// The jet at node n with p'' from the inverse Legendre transform ∂ℓ/∂p''(x_n, v_n, p'', Ω_n) = π_v
+// (Newton; ℓ must be strictly convex in p'', the regularity of a higher-order Lagrangian).
+// Ω' is not available at nodes and is set to zero (ℓ must not depend on it). False if Newton
+// does not converge.
+template <class Sch>
+bool node_jet(const typename Sch::Model& model, const GalerkinTrajectory<Sch>& tr, int n, Jet<typename Sch::Model, double>& q) {
+  using C = typename Sch::Model;
+  constexpr int r = Sch::r;
+  const Vec<double, r> pi = node_velocity_momentum(model, tr, n);
+  q.p = tr.x(n);
+  q.dp = tr.v(n);
+  q.Omega = tr.Omega(n);
+  q.dOmega.setZero();
+  // Start from the curve's own p'' at the node (interval n's, or interval n-1's at the end).
+  if (n < tr.N())
+    q.ddp = 6.0 * tr.intervals[n].X2 - 2.0 * tr.intervals[n].V1;
+  else
+    q.ddp = -6.0 * tr.intervals[n - 1].X2 + 4.0 * tr.intervals[n - 1].V1;
+  using T1 = Dual<double, r>;
+  using T2 = Dual<T1, r>;
+  for (int it = 0; it < 20; ++it) {
+    Jet<C, T2> qt;
+    qt.p = q.p.template cast<T2>(), qt.dp = q.dp.template cast<T2>();
+    qt.Omega = q.Omega.template cast<T2>(), qt.dOmega = q.dOmega.template cast<T2>();
+    for (int a = 0; a < r; ++a) qt.ddp(a) = T2(T1::variable(q.ddp(a), a));
+    for (int a = 0; a < r; ++a) qt.ddp(a).d[a] = T1(1.0);
+    const T2 l = model.template lagrangian<T2>(qt);
+    Vec<double, r> g;
+    Eigen::Matrix<double, r, r> H;
+    for (int a = 0; a < r; ++a) {
+      g(a) = l.d[a].v - pi(a);
+      for (int b = 0; b < r; ++b) H(a, b) = l.d[a].d[b];
+    }
+    const Vec<double, r> step = H.partialPivLu().solve(-g);
+    if (!step.allFinite()) return false;
+    q.ddp += step;
+    if (step.template lpNorm<Eigen::Infinity>() <= 1e-14 * (1.0 + q.ddp.template lpNorm<Eigen::Infinity>())) return true;
+  }
+  return false;
+}
+
+}  // namespace lpshoot

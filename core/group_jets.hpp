@@ -1,0 +1,72 @@
+// Velocities along group curves, for any of lpshoot's groups (used by the Galerkin schemes'
+// group part, METHOD.md §9 route (a): g(t) = g_n exp(ξ(t)) with ξ a polynomial in the algebra).
+//   body_velocity_jet: Ω and Ω' of exp(ξ(s)) at s = 0 from the Taylor series of ξ, through
+//     log(exp(ξ(0))^{-1} exp(ξ(s))) = Ω s + Ω' s^2 / 2 + O(s^3);
+//   right_jacobian: Jr(ζ) Y = d/dε log(exp(ζ)^{-1} exp(ζ + ε Y)), the body velocity of exp(ξ)
+//     at ξ = ζ per unit ξ'.
+#pragma once
+
+#include "groups.hpp"
+#include "taylor.hpp"
+
+#include <utility>
+
+namespace lpshoot {
+
+template <class G, class T>
+void body_velocity_jet(const typename G::template Tangent<Taylor2<T>>& xi, typename G::template Tangent<T>& Omega,
+                       typename G::template Tangent<T>& dOmega) {
+  using TT = Taylor2<T>;
+  typename G::template Tangent<T> xi0;
+  for (int a = 0; a < G::dim; ++a) xi0(a) = xi(a).c0;
+  const auto start_inverse = G::template cast<TT>(G::inverse(G::template exp<T>(xi0)));
+  const typename G::template Tangent<TT> rel = G::log(G::compose(start_inverse, G::template exp<TT>(xi)));
+  for (int a = 0; a < G::dim; ++a) {
+    Omega(a) = rel(a).c1;
+    dOmega(a) = 2.0 * rel(a).c2;
+  }
+}
+
+template <class G, class T>
+Eigen::Matrix<T, G::dim, G::dim> right_jacobian(const typename G::template Tangent<T>& zeta) {
+  constexpr int d = G::dim;
+  using TD = Dual<T, d>;
+  typename G::template Tangent<TD> z;
+  for (int a = 0; a < d; ++a) z(a) = TD::variable(zeta(a), a);
+  const auto start_inverse = G::template cast<TD>(G::inverse(G::template exp<T>(zeta)));
+  const typename G::template Tangent<TD> rel = G::log(G::compose(start_inverse, G::template exp<TD>(z)));
+  Eigen::Matrix<T, d, d> J;
+  for (int i = 0; i < d; ++i)
+    for (int j = 0; j < d; ++j) J(i, j) = rel(i).d[j];
+  return J;
+}
+
+// x = A^{-1} b for a small square A in any scalar (Gaussian elimination, partial pivoting on the
+// double values).
+template <class T, int n>
+Eigen::Matrix<T, n, 1> solve_small(Eigen::Matrix<T, n, n> A, Eigen::Matrix<T, n, 1> b) {
+  for (int c = 0; c < n; ++c) {
+    int p = c;
+    for (int i = c + 1; i < n; ++i)
+      if (std::abs(value(A(i, c))) > std::abs(value(A(p, c)))) p = i;
+    if (p != c) {
+      A.row(c).swap(A.row(p));
+      std::swap(b(c), b(p));
+    }
+    const T inv = T(1.0) / A(c, c);
+    for (int i = c + 1; i < n; ++i) {
+      const T f = A(i, c) * inv;
+      for (int j = c + 1; j < n; ++j) A(i, j) = A(i, j) - f * A(c, j);
+      b(i) = b(i) - f * b(c);
+    }
+  }
+  Eigen::Matrix<T, n, 1> x;
+  for (int i = n - 1; i >= 0; --i) {
+    T s = b(i);
+    for (int j = i + 1; j < n; ++j) s = s - A(i, j) * x(j);
+    x(i) = s / A(i, i);
+  }
+  return x;
+}
+
+}  // namespace lpshoot

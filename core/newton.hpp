@@ -1,0 +1,161 @@
+// The small dense Newton solver behind every flow step (both discretizations), and the reports
+// of a step and of a flow.
+//
+// Newton from a predictor with an exact Jacobian; after a Newton step, chord steps (same
+// factorization, residual only) are taken while they contract by 4x, else the Jacobian is
+// refreshed. The 1-norm condition number of the step matrix is the regularity diagnostic (paper
+// Proposition 2): above NewtonOptions::max_condition the step is reported singular, naming it.
+// Everything is fixed size: no allocation in the loop except the failure message.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/LU>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace lpshoot {
+
+enum class StepStatus { Converged, NotConverged, Singular, NonFinite };
+
+struct StepReport {
+  int step = -1;  // n
+  StepStatus status = StepStatus::NotConverged;
+  int iterations = 0;
+  double residual = 0;   // max-norm of F at the last evaluation
+  double condition = 0;  // 1-norm condition number of ∂F/∂z at the last evaluation
+  std::string message;   // empty when converged
+};
+
+struct NewtonOptions {
+  int max_iterations = 20;
+  // Converged when every Newton correction satisfies |dz_i| <= step_tolerance * (1 + |z_i|).
+  double step_tolerance = 1e-12;
+  // A step whose ∂F/∂z has a larger condition estimate is reported singular.
+  double max_condition = 1e13;
+};
+
+enum class FlowStatus { Ok, NotConverged, Singular, NonFinite, InvalidInput };
+
+struct FlowReport {
+  FlowStatus status = FlowStatus::Ok;
+  std::string message;      // empty when Ok; names the failed step otherwise
+  int failed_step = -1;
+  int steps = 0;            // steps completed
+  int total_iterations = 0;
+  int max_iterations = 0;
+  double max_residual = 0;
+  double max_condition = 0;
+  bool ok() const { return status == FlowStatus::Ok; }
+
+  // Accounts for one step; false (with the failure recorded) when it did not converge.
+  bool add(const StepReport& sr) {
+    total_iterations += sr.iterations;
+    max_iterations = std::max(max_iterations, sr.iterations);
+    max_residual = std::max(max_residual, sr.residual);
+    max_condition = std::max(max_condition, sr.condition);
+    if (sr.status == StepStatus::Converged) {
+      ++steps;
+      return true;
+    }
+    status = sr.status == StepStatus::Singular    ? FlowStatus::Singular
+             : sr.status == StepStatus::NonFinite ? FlowStatus::NonFinite
+                                                  : FlowStatus::NotConverged;
+    message = sr.message;
+    failed_step = sr.step;
+    return false;
+  }
+};
+
+// Short numeric text for messages ("1.2e+16").
+inline std::string format_number(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", x);
+  return buf;
+}
+
+// ||J||_1 ||J^{-1}||_1 from the LU factors (exact, cheap at these sizes); inf or NaN if singular.
+// J^{-1} e_j by plain substitutions: P J = L U, so J^{-1} e_j = U^{-1} L^{-1} P e_j.
+template <class M, class LU>
+double condition_number_1(const M& J, const LU& lu) {
+  constexpr int n = M::RowsAtCompileTime;
+  const M& f = lu.matrixLU();
+  const auto perm = lu.permutationP().indices();
+  double inv_norm = 0;
+  for (int j = 0; j < n; ++j) {
+    double x[n > 0 ? n : 1];
+    for (int i = 0; i < n; ++i) x[i] = perm(j) == i ? 1.0 : 0.0;
+    for (int i = 0; i < n; ++i)
+      for (int c = 0; c < i; ++c) x[i] -= f(i, c) * x[c];
+    double col = 0;
+    for (int i = n - 1; i >= 0; --i) {
+      for (int c = i + 1; c < n; ++c) x[i] -= f(i, c) * x[c];
+      x[i] /= f(i, i);
+      col += std::abs(x[i]);
+    }
+    if (!(col <= inv_norm)) inv_norm = col;  // keeps a NaN from a zero pivot
+  }
+  return J.cwiseAbs().colwise().sum().maxCoeff() * inv_norm;
+}
+
+inline bool all_finite(const double* x, int n) {
+  for (int i = 0; i < n; ++i)
+    if (!std::isfinite(x[i])) return false;
+  return true;
+}
+
+// Solves F(z) = 0 for a step with n unknowns. The callbacks:
+//   jacobian(F, J): F and ∂F/∂z at the current z;  residual(F): F only;
+//   correct(dz): z <- z ⊕ dz;  magnitude(): |z_i| for the convergence test (0 for group parts).
+template <int n, class Jacobian, class Residual, class Correct, class Magnitude>
+StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian, Residual&& residual, Correct&& correct,
+                        Magnitude&& magnitude) {
+  StepReport rep;
+  rep.step = step;
+  auto fail = [&](StepStatus st, const std::string& why) {
+    rep.status = st;
+    rep.message = "step n=" + std::to_string(step) + ": " + why;
+    return rep;
+  };
+  using Vn = Eigen::Matrix<double, n, 1>;
+  Vn F;
+  Eigen::Matrix<double, n, n> J;
+  Eigen::PartialPivLU<Eigen::Matrix<double, n, n>> lu;
+  bool refresh = true;
+  double last_step = std::numeric_limits<double>::infinity();
+  for (int it = 1; it <= opt.max_iterations; ++it) {
+    rep.iterations = it;
+    if (refresh) {
+      jacobian(F, J);
+      if (!all_finite(F.data(), n) || !all_finite(J.data(), n * n))
+        return fail(StepStatus::NonFinite, "the step equations evaluated to a non-finite number");
+      lu.compute(J);
+      rep.condition = condition_number_1(J, lu);
+      if (!(rep.condition <= opt.max_condition))
+        return fail(StepStatus::Singular, "the step matrix (Proposition 2) is singular (condition " +
+                                              format_number(rep.condition) + " > " +
+                                              format_number(opt.max_condition) + ")");
+    } else {
+      residual(F);
+      if (!all_finite(F.data(), n)) return fail(StepStatus::NonFinite, "the step equations evaluated to a non-finite number");
+    }
+    rep.residual = F.template lpNorm<Eigen::Infinity>();
+    const Vn dz = lu.solve(-F);
+    const Vn scale = magnitude();
+    correct(dz);
+    if (((dz.cwiseAbs().array() - opt.step_tolerance * (1.0 + scale.array())) <= 0.0).all()) {
+      rep.status = StepStatus::Converged;
+      return rep;
+    }
+    const double size = dz.template lpNorm<Eigen::Infinity>();
+    refresh = refresh ? false : !(size <= 0.25 * last_step);  // after a chord step that contracts too slowly
+    last_step = size;
+  }
+  return fail(StepStatus::NotConverged, "Newton did not converge in " + std::to_string(opt.max_iterations) +
+                                            " iterations (residual " + format_number(rep.residual) + ")");
+}
+
+}  // namespace lpshoot

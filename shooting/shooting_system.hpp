@@ -1,0 +1,236 @@
+// The shooting equations (METHOD.md §5) for any discretization, through its scheme adapter A
+// (scheme_nodal.hpp: the paper's windows; scheme_galerkin.hpp: Galerkin on node states).
+//
+// Unknowns: the extended state (flow state + group element) at the start of each segment, in
+// the scheme's basis M around a reference state (x = ref ⊕ M^{-1} u). Residuals: the initial
+// rows (the first state's own equations and the initial conditions), the continuity defects
+// M (end of segment i ⊖ start of segment i+1) (group parts in the tangent space), the terminal
+// conditions on the last segment's end. The Jacobian is exact: flow sensitivities (implicit
+// function theorem) times automatic derivatives of the conditions; it is block bidiagonal and
+// the segments are propagated in parallel.
+#pragma once
+
+#include "nonlinear_solver.hpp"
+#include "scheme_galerkin.hpp"
+#include "scheme_nodal.hpp"
+
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <limits>
+#include <thread>
+
+namespace lpshoot {
+
+template <class P>
+struct ShootingGuess {  // the paper's scheme: a full discrete trajectory and g_0
+  Trajectory<P> trajectory;
+  GroupElement<P, double> g0 = P::Group::template identity<double>();
+};
+
+// The scheme adapter of a key: a discrete problem P (the paper's windows), or Galerkin<C, S, Q>.
+template <class X>
+struct SchemeOf {
+  using type = NodalScheme<X>;
+};
+template <class C, int S, int Q>
+struct SchemeOf<Galerkin<C, S, Q>> {
+  using type = GalerkinScheme<Galerkin<C, S, Q>>;
+};
+template <class X>
+using SchemeFor = typename SchemeOf<X>::type;
+
+namespace detail {
+
+// The shooting equations for S >= 1 segments between state indices s_0 < s_1 < ... < s_S
+// (s_0 = A::first_state, s_S = A::last_state).
+template <class X>
+class ShootingSystem : public NonlinearSystem {
+ public:
+  using A = SchemeFor<X>;
+  using State = typename A::State;
+  static constexpr int n = A::size;
+  ShootingSystem(const typename A::BVP& bvp, std::vector<State> refs, std::vector<int> starts, const NewtonOptions& step,
+                 int threads)
+      : bvp_(bvp), refs_(std::move(refs)), starts_(std::move(starts)), flow_(A::flow(bvp, step)), threads_(threads),
+        M_(A::basis(bvp)), Minv_(M_.inverse()) {}
+
+  int size() const override { return n * static_cast<int>(refs_.size()); }
+  int segments() const { return static_cast<int>(refs_.size()); }
+
+  // Residual rows may be scaled by w (none by default: the conditions are solved in their own units).
+  bool residual(const Eigen::VectorXd& x, Eigen::VectorXd& F) override {
+    if (!evaluate(x, F, nullptr)) return false;
+    if (w_.size() == F.size()) F.array() *= w_.array();
+    return true;
+  }
+  bool jacobian(const Eigen::VectorXd& x, Eigen::MatrixXd& J) override {
+    Eigen::VectorXd F;
+    if (!evaluate(x, F, &J)) return false;
+    if (w_.size() == J.rows()) J = w_.asDiagonal() * J;
+    return true;
+  }
+  void set_row_scaling(const Eigen::VectorXd& w) { w_ = w; }
+  double progress_norm(const Eigen::VectorXd& F) const override {
+    return w_.size() == F.size() ? F.cwiseQuotient(w_).lpNorm<Eigen::Infinity>() : F.lpNorm<Eigen::Infinity>();
+  }
+
+  // Per-row tolerances: `tol` plus the roundoff floor of each row, 64 u |J_δ| |state|: the
+  // rounding of the state's values (magnitudes |state|) propagated through the row's derivative
+  // with respect to them (J_δ: the raw Jacobian in tangent coordinates, at x). It covers the
+  // differences in the continuity rows and the flow's amplification over a segment.
+  Eigen::VectorXd row_tolerances(const Eigen::VectorXd& x, double tol) {
+    const int S = segments();
+    Eigen::VectorXd F;
+    Eigen::MatrixXd J;
+    const Eigen::VectorXd w = w_;
+    w_.resize(0);
+    const bool ok = evaluate(x, F, &J);
+    w_ = w;
+    Eigen::VectorXd t = Eigen::VectorXd::Constant(size(), tol);
+    if (!ok) return t;
+    Eigen::VectorXd mag(size());
+    for (int i = 0; i < S; ++i) mag.segment(i * n, n) = A::magnitudes(bvp_, refs_[i]);
+    Eigen::MatrixXd Jd = J;  // J_x M = J_δ, per segment block of columns
+    for (int i = 0; i < S; ++i) Jd.middleCols(i * n, n) = J.middleCols(i * n, n) * M_;
+    constexpr double u = std::numeric_limits<double>::epsilon();
+    const Eigen::ArrayXd floor = 64 * u * (Jd.cwiseAbs() * mag).array();
+    t.array() += floor.min(1e4 * tol);  // at most four digits conceded to roundoff: beyond, not converged
+    // A continuity row of two states cannot be known better than their rounding, u |M| |state|,
+    // whatever the tolerance (nodal windows, h = 5e-4, third differences: ~2e-6 for |p| ~ 1).
+    // A defect at that level means states equal to the last bit; this part is not capped.
+    const int first_continuity = size() - (S - 1) * n - terminal_rows();
+    for (int i = 0; i + 1 < S; ++i)
+      t.segment(first_continuity + i * n, n).array() += 4 * u * (M_.cwiseAbs() * mag.segment((i + 1) * n, n)).array();
+    return t;
+  }
+
+  // The conditions in their own units (no row scaling).
+  bool raw_residual(const Eigen::VectorXd& x, Eigen::VectorXd& F) { return evaluate(x, F, nullptr); }
+
+  // Runs all segments at x; fills the per-segment results. False if a flow failed.
+  bool propagate(const Eigen::VectorXd& x, bool sensitivities, std::vector<typename A::Run>& runs,
+                 std::vector<State>& starts, std::vector<Eigen::MatrixXd>& Jr) {
+    const int S = segments();
+    runs.resize(S);
+    starts.resize(S);
+    Jr.resize(S);
+    for (int i = 0; i < S; ++i) {
+      starts[i] = A::retract(bvp_, refs_[i], Eigen::VectorXd(Minv_ * x.segment(i * n, n)), sensitivities ? &Jr[i] : nullptr);
+      if (sensitivities) Jr[i] = Jr[i] * Minv_;  // d(tangent at the start)/d(unknowns)
+    }
+    // The flow propagates the unknowns' own directions (Jr), not the state's: in the nodal
+    // scheme a direction such as "move p_{2k-1} alone" is a (2k-1)-th difference of size
+    // h^{-(2k-1)}, whose sensitivity would be recombined into O(1) entries afterwards by
+    // cancellation, losing ~(2k-1) log10(1/h) digits twice.
+    auto work = [&](int i) {
+      runs[i] = A::run(flow_, starts[i], starts_[i], starts_[i + 1] - starts_[i], sensitivities ? &Jr[i] : nullptr);
+    };
+    const int T = std::max(1, std::min(S, threads_ > 0 ? threads_ : static_cast<int>(std::thread::hardware_concurrency())));
+    if (T == 1) {
+      for (int i = 0; i < S; ++i) work(i);
+    } else {
+      std::vector<std::thread> pool;
+      for (int t = 0; t < T; ++t)
+        pool.emplace_back([&, t] {
+          for (int i = t; i < S; i += T) work(i);
+        });
+      for (auto& th : pool) th.join();
+    }
+    last_failure_.clear();
+    for (int i = 0; i < S; ++i)
+      if (!runs[i].report.ok()) {
+        last_failure_ = "segment " + std::to_string(i) + ": " + runs[i].report.message;
+        return false;
+      }
+    return true;
+  }
+
+  const std::string& last_failure() const { return last_failure_; }
+  const std::vector<int>& starts() const { return starts_; }
+  const typename A::BVP& bvp() const { return bvp_; }
+  std::vector<std::string> row_names() const {
+    std::vector<std::string> names = A::initial_equation_names(bvp_);
+    for (const auto& c : bvp_.conditions)
+      if (c.end == End::Initial) names.push_back(c.name);
+    for (int i = 0; i + 1 < segments(); ++i)
+      for (int a = 0; a < n; ++a) names.push_back("continuity " + std::to_string(i) + "." + std::to_string(a));
+    for (const auto& c : bvp_.conditions)
+      if (c.end == End::Terminal) names.push_back(c.name);
+    return names;
+  }
+  int terminal_rows() const {
+    return static_cast<int>(std::count_if(bvp_.conditions.begin(), bvp_.conditions.end(),
+                                          [](const auto& c) { return c.end == End::Terminal; }));
+  }
+
+ private:
+  // The conditions (unscaled) at x, with their Jacobian when J is given. The last evaluation is
+  // kept: the solver asks again for what the setup (row tolerances) already computed at the guess.
+  bool evaluate(const Eigen::VectorXd& x, Eigen::VectorXd& F, Eigen::MatrixXd* J) {
+    const bool same_x = memo_x_.size() == x.size() && memo_x_ == x;
+    if (same_x && (!J || memo_has_J_)) {
+      if (!memo_ok_) return false;
+      F = memo_F_;
+      if (J) *J = memo_J_;
+      return true;
+    }
+    memo_x_ = x;
+    memo_has_J_ = J != nullptr;
+    memo_ok_ = evaluate_uncached(x, F, J);
+    if (memo_ok_) {
+      memo_F_ = F;
+      if (J) memo_J_ = *J;
+    }
+    return memo_ok_;
+  }
+
+  bool evaluate_uncached(const Eigen::VectorXd& x, Eigen::VectorXd& F, Eigen::MatrixXd* J) {
+    std::vector<typename A::Run> runs;
+    std::vector<State> starts;
+    std::vector<Eigen::MatrixXd> Jr;
+    if (!propagate(x, J != nullptr, runs, starts, Jr)) return false;
+    const int S = segments(), N = size();
+    F.resize(N);
+    if (J) J->setZero(N, N);
+    int row = 0;
+    Eigen::VectorXd R;
+    Eigen::MatrixXd JB;
+    A::boundary_block(bvp_, End::Initial, starts[0], R, J ? &JB : nullptr);
+    F.segment(row, R.size()) = R;
+    if (J) J->block(row, 0, R.size(), n) = JB * Jr[0];
+    row += R.size();
+    for (int i = 0; i + 1 < S; ++i) {  // continuity: end of segment i minus start of segment i+1
+      const State e = A::end_state(runs[i]);
+      F.segment(row, n) = M_ * A::difference(bvp_, e, starts[i + 1]);
+      if (J) {
+        Eigen::MatrixXd De, Ds;
+        A::difference_jacobians(bvp_, e, starts[i + 1], De, Ds);
+        J->block(row, i * n, n, n) = M_ * De * runs[i].sensitivity;
+        J->block(row, (i + 1) * n, n, n) = M_ * Ds * Jr[i + 1];
+      }
+      row += n;
+    }
+    const State e = A::end_state(runs[S - 1]);
+    A::boundary_block(bvp_, End::Terminal, e, R, J ? &JB : nullptr);
+    F.segment(row, R.size()) = R;
+    if (J) J->block(row, (S - 1) * n, R.size(), n) = JB * runs[S - 1].sensitivity;
+    row += R.size();
+    return row == N;
+  }
+
+  typename A::BVP bvp_;
+  std::vector<State> refs_;
+  std::vector<int> starts_;
+  typename A::Flow flow_;
+  int threads_;
+  std::string last_failure_;
+  Eigen::MatrixXd M_, Minv_;
+  Eigen::VectorXd w_;
+  Eigen::VectorXd memo_x_, memo_F_;
+  Eigen::MatrixXd memo_J_;
+  bool memo_has_J_ = false, memo_ok_ = false;
+};
+
+}  // namespace detail
+}  // namespace lpshoot
