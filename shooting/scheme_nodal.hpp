@@ -190,6 +190,7 @@ struct NodalScheme {
   using Flow = DiscreteFlow<P>;
   using Run = FlowResult<P>;
   using GroupElem = GroupElement<P, double>;
+  static constexpr double roundoff_factor = 64;
   static constexpr int size = BoundaryState<P>::size;
   static constexpr int k = P::order;
 

@@ -75,10 +75,12 @@ class ShootingSystem : public NonlinearSystem {
     return w_.size() == F.size() ? F.cwiseQuotient(w_).lpNorm<Eigen::Infinity>() : F.lpNorm<Eigen::Infinity>();
   }
 
-  // Per-row tolerances: `tol` plus the roundoff floor of each row, 64 u |J_δ| |state|: the
+  // Per-row tolerances: `tol` plus the roundoff floor of each row, c u |J_δ| |state|: the
   // rounding of the state's values (magnitudes |state|) propagated through the row's derivative
   // with respect to them (J_δ: the raw Jacobian in tangent coordinates, at x). It covers the
-  // differences in the continuity rows and the flow's amplification over a segment.
+  // differences in the continuity rows and the flow's amplification over a segment; c is the
+  // scheme's (A::roundoff_factor: 64 for nodal windows, whose flow amplifies rounding like L^4
+  // over L steps; 4 for the Galerkin increments, which do not).
   Eigen::VectorXd row_tolerances(const Eigen::VectorXd& x, double tol) {
     const int S = segments();
     Eigen::VectorXd F;
@@ -94,7 +96,7 @@ class ShootingSystem : public NonlinearSystem {
     Eigen::MatrixXd Jd = J;  // J_x M = J_δ, per segment block of columns
     for (int i = 0; i < S; ++i) Jd.middleCols(i * n, n) = J.middleCols(i * n, n) * M_;
     constexpr double u = std::numeric_limits<double>::epsilon();
-    const Eigen::ArrayXd floor = 64 * u * (Jd.cwiseAbs() * mag).array();
+    const Eigen::ArrayXd floor = A::roundoff_factor * u * (Jd.cwiseAbs() * mag).array();
     t.array() += floor.min(1e4 * tol);  // at most four digits conceded to roundoff: beyond, not converged
     // A continuity row of two states cannot be known better than their rounding, u |M| |state|,
     // whatever the tolerance (nodal windows, h = 5e-4, third differences: ~2e-6 for |p| ~ 1).

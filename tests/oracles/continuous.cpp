@@ -1,5 +1,6 @@
 #include "oracles/continuous.hpp"
 
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 
 #include <boost/numeric/odeint.hpp>
@@ -126,6 +127,95 @@ BeanieOptimum beanie_continuous_optimum(const problems::BeanieParameters& par, d
     r.psi.push_back(y[0]);
     r.dpsi.push_back(y[1]);
     r.u.push_back(y[2]);
+  }
+  return r;
+}
+
+// ---------------------------------------------------------------- nonlinear electron, METHOD.md §9
+
+namespace {
+using ElectronState = std::array<double, 13>;  // x, x', u, u', ½ ∫ |u|²
+
+struct ElectronSystem {
+  const problems::ElectronModel& e;
+  void operator()(const ElectronState& y, ElectronState& dy, double /*t*/) const {
+    const Eigen::Vector3d x(y[0], y[1], y[2]), v(y[3], y[4], y[5]), u(y[6], y[7], y[8]), du(y[9], y[10], y[11]);
+    Eigen::Vector3d grad = 2 * e.potential * x;
+    grad(0) += 4 * e.quartic * x(0) * x(0) * x(0);
+    Eigen::Matrix3d H = 2 * e.potential * Eigen::Matrix3d::Identity();
+    H(0, 0) += 12 * e.quartic * x(0) * x(0);
+    const Eigen::Vector3d ddx = (u - grad + e.e_over_c * v.cross(e.B)) / e.mass;
+    const Eigen::Vector3d ddu = (e.e_over_c * du.cross(e.B) - H * u) / e.mass;
+    for (int i = 0; i < 3; ++i) {
+      dy[i] = v(i);
+      dy[3 + i] = ddx(i);
+      dy[6 + i] = du(i);
+      dy[9 + i] = ddu(i);
+    }
+    dy[12] = 0.5 * u.squaredNorm();
+  }
+};
+
+std::vector<ElectronState> shoot_electron(const problems::ElectronModel& e, const Eigen::Vector3d& x0,
+                                          const Eigen::Vector3d& v0, const Eigen::Matrix<double, 6, 1>& z,
+                                          const std::vector<double>& grid) {
+  ElectronState y{};
+  for (int i = 0; i < 3; ++i) {
+    y[i] = x0(i);
+    y[3 + i] = v0(i);
+    y[6 + i] = z(i);
+    y[9 + i] = z(3 + i);
+  }
+  std::vector<ElectronState> out;
+  auto stepper = odeint::make_dense_output(1e-13, 1e-13, odeint::runge_kutta_dopri5<ElectronState>());
+  odeint::integrate_times(stepper, ElectronSystem{e}, y, grid.begin(), grid.end(), grid.back() / 200,
+                          [&out](const ElectronState& s, double) { out.push_back(s); });
+  return out;
+}
+}  // namespace
+
+ElectronNonlinearOptimum electron_nonlinear_optimum(const problems::ElectronModel& model, double T,
+                                                    const Eigen::Vector3d& x0, const Eigen::Vector3d& v0,
+                                                    const Eigen::Vector3d& xT, const Eigen::Vector3d& vT,
+                                                    const std::vector<double>& times) {
+  std::vector<double> grid{0.0};
+  grid.insert(grid.end(), times.begin(), times.end());
+  grid.push_back(T);
+  std::sort(grid.begin(), grid.end());
+  grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
+  auto residual = [&](const std::vector<ElectronState>& traj) {
+    const ElectronState& y = traj.back();
+    Eigen::Matrix<double, 6, 1> F;
+    for (int i = 0; i < 3; ++i) {
+      F(i) = y[i] - xT(i);
+      F(3 + i) = y[3 + i] - vT(i);
+    }
+    return F;
+  };
+  ElectronNonlinearOptimum r;
+  Eigen::Matrix<double, 6, 1> z = Eigen::Matrix<double, 6, 1>::Zero();
+  auto traj = shoot_electron(model, x0, v0, z, grid);
+  Eigen::Matrix<double, 6, 1> F = residual(traj);
+  while (F.lpNorm<Eigen::Infinity>() > 1e-12 && r.iterations < 30) {
+    Eigen::Matrix<double, 6, 6> J;
+    for (int j = 0; j < 6; ++j) {  // central differences
+      Eigen::Matrix<double, 6, 1> zp = z, zm = z;
+      const double eps = 1e-6 * (1 + std::abs(z(j)));
+      zp(j) += eps;
+      zm(j) -= eps;
+      J.col(j) = (residual(shoot_electron(model, x0, v0, zp, {0.0, T})) - residual(shoot_electron(model, x0, v0, zm, {0.0, T}))) / (2 * eps);
+    }
+    z -= J.fullPivLu().solve(F);
+    traj = shoot_electron(model, x0, v0, z, grid);
+    F = residual(traj);
+    ++r.iterations;
+  }
+  r.converged = F.lpNorm<Eigen::Infinity>() <= 1e-12;
+  r.cost = traj.back()[12];
+  for (double t : times) {
+    const ElectronState& y = traj[std::lower_bound(grid.begin(), grid.end(), t) - grid.begin()];
+    r.x.emplace_back(y[0], y[1], y[2]);
+    r.u.emplace_back(y[6], y[7], y[8]);
   }
   return r;
 }

@@ -34,4 +34,21 @@ BeanieOptimum beanie_continuous_optimum(const problems::BeanieParameters& par, d
                                         double dpsi0, double psiT, double dpsiT,
                                         const std::vector<double>& times);
 
+// The electron-type problem with a nonlinear potential (METHOD.md §9's check): ℓ = ½ |u|²,
+// u = m x'' + ∇φ(x) - (e/c) x' × B, φ = potential |x|² + quartic x1⁴. Necessary conditions:
+// m x'' = u - ∇φ(x) + (e/c) x' × B,  m u'' = (e/c) u' × B - ∇²φ(x) u; solved by Newton shooting on
+// (u(0), u'(0)) (finite-difference Jacobian) with an adaptive dense-output Dormand–Prince
+// integrator at tolerances 1e-13.
+struct ElectronNonlinearOptimum {
+  bool converged = false;
+  int iterations = 0;
+  double cost = 0;                        // ½ ∫ |u|² dt
+  std::vector<Eigen::Vector3d> x, u;      // at the requested times
+};
+
+ElectronNonlinearOptimum electron_nonlinear_optimum(const problems::ElectronModel& model, double T,
+                                                    const Eigen::Vector3d& x0, const Eigen::Vector3d& v0,
+                                                    const Eigen::Vector3d& xT, const Eigen::Vector3d& vT,
+                                                    const std::vector<double>& times);
+
 }  // namespace lpshoot::oracles
