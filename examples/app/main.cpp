@@ -1,7 +1,8 @@
 // lpshoot: the command-line application (CLI11 stays in this file).
 //   lpshoot solve SCENE.json [--out DIR] [--set key.path=value ...]
 //   lpshoot simulate SCENE.json [...]
-//   lpshoot sweep SCENE.json --N 50,100,200 [--method single,multiple] [--backend kinsol,nlopt]
+//   lpshoot sweep SCENE.json --N 50,100,200 [--scheme paper,galerkin4,galerkin6] [--method single,multiple]
+//                [--backend kinsol,nlopt]
 //   lpshoot check SCENE.json
 // Exit codes: 0 converged; 1 the run did not converge (the report says why); 2 bad command line
 // or scene; 3 the results could not be written.
@@ -50,10 +51,13 @@ void print_files(const Written& w) {
 
 void print_run(const RunRecord& r) {
   std::printf("%s %s: N = %d, T = %g, h = %g", r.command.c_str(), r.problem.c_str(), r.N, r.T, r.h);
-  if (!r.method.empty())
-    std::printf(", %s shooting%s, %s, %s closure%s%s", r.method.c_str(),
+  if (!r.method.empty()) {
+    std::printf(", %s shooting%s, %s, %s scheme", r.method.c_str(),
                 r.segments > 1 ? (" (" + std::to_string(r.segments) + " segments)").c_str() : "", r.backend.c_str(),
-                r.closure.c_str(), r.constraints.empty() ? "" : ", constraints ", r.constraints.c_str());
+                r.scheme.c_str());
+    if (!r.closure.empty()) std::printf(" (%s closure)", r.closure.c_str());
+    if (!r.constraints.empty()) std::printf(", constraints %s", r.constraints.c_str());
+  }
   std::printf("\nstatus: %s (%s)\n", r.status.c_str(), r.message.c_str());
   if (r.command == "solve")
     std::printf("residual: %s x tolerance (raw %s), Jacobian condition %s, rank %d of %d\n",
@@ -93,12 +97,14 @@ void print_run(const RunRecord& r) {
 void print_sweep(const SweepRecord& sw) {
   std::printf("sweep %s: errors against the %s, max over nodes of |", sw.problem.c_str(), sw.reference.c_str());
   for (size_t i = 0; i < sw.error_columns.size(); ++i) std::printf("%s%s", i ? ", " : "", sw.error_columns[i].c_str());
-  std::printf("|\n%7s %10s %-22s %-13s %10s %6s %12s %10s %9s %5s\n", "N", "h", "solver", "status", "error", "order",
+  std::printf("|\n%7s %10s %-32s %-13s %10s %6s %12s %10s %9s %5s\n", "N", "h", "solver", "status", "error", "order",
               "cost", "cost err", "time [s]", "iter");
   for (const auto& r : sw.runs) {
-    const std::string solver = r.method.empty() ? "flow" : r.method + (r.segments > 1 ? "(" + std::to_string(r.segments) + ")" : "") + "/" + r.backend;
+    const std::string solver = r.method.empty() ? "flow"
+                                                : r.scheme + "/" + r.method +
+                                                      (r.segments > 1 ? "(" + std::to_string(r.segments) + ")" : "") + "/" + r.backend;
     auto opt = [](const char* f, double x) { return std::isfinite(x) ? fmt(f, x) : std::string("-"); };
-    std::printf("%7d %10.4g %-22s %-13s %10s %6s %12s %10s %9.4f %5d\n", r.N, r.h, solver.c_str(), r.status.c_str(),
+    std::printf("%7d %10.4g %-32s %-13s %10s %6s %12s %10s %9.4f %5d\n", r.N, r.h, solver.c_str(), r.status.c_str(),
                 opt("%.3e", r.error).c_str(), opt("%.2f", r.order).c_str(), opt("%.8g", r.cost).c_str(),
                 opt("%.2e", r.cost_error).c_str(), r.wall_time_s, r.iterations);
   }
@@ -136,10 +142,13 @@ int main(int argc, char** argv) {
   scene_options(sweep, true);
   scene_options(check, false);
   std::vector<int> grids;
-  std::vector<std::string> methods, backends;
+  std::vector<std::string> methods, backends, schemes;
   int steps_per_segment = 0;
   std::string reference = "auto";
   sweep->add_option("--N", grids, "grids, comma separated (e.g. 50,100,200,400)")->required()->delimiter(',');
+  sweep->add_option("--scheme", schemes, "discretizations to compare (paper,galerkin4,galerkin6)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"paper", "galerkin4", "galerkin6"}));
   sweep->add_option("--method", methods, "shooting methods to compare (single,multiple)")
       ->delimiter(',')
       ->check(CLI::IsMember({"single", "multiple"}));
@@ -176,11 +185,13 @@ int main(int argc, char** argv) {
     if (sweep->parsed()) {
       SweepOptions so;
       so.N = grids;
+      so.schemes = schemes;
       for (const auto& m : methods) so.methods.push_back(m == "multiple" ? ShootingMethod::Multiple : ShootingMethod::Single);
       for (const auto& b : backends) so.backends.push_back(b == "nlopt" ? Backend::Nlopt : Backend::Kinsol);
-      if (!scene.is_optimal_control() && (!so.methods.empty() || !so.backends.empty() || steps_per_segment > 0))
-        return fail_input("--method/--backend/--steps-per-segment: a " + scene.problem_name +
-                          " simulation has no shooting solver to choose");
+      if (!scene.is_optimal_control() &&
+          (!so.methods.empty() || !so.backends.empty() || !so.schemes.empty() || steps_per_segment > 0))
+        return fail_input("--scheme/--method/--backend/--steps-per-segment: a " + scene.problem_name +
+                          " simulation has no scheme or shooting solver to choose");
       so.steps_per_segment = steps_per_segment;
       so.use_exact = reference == "auto";
       const SweepRecord sw = run_sweep(scene, scene.is_optimal_control() ? "solve" : "simulate", so, progress);

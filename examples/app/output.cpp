@@ -212,7 +212,8 @@ Written write_run(const Scene& scene, const RunRecord& r, const std::string& dir
     j["segments"] = r.segments;
     if (r.segments > 1) j["segment_starts"] = r.propagated_starts ? "forward sweep" : "guess";
     j["backend"] = r.backend;
-    j["closure"] = r.closure;
+    j["scheme"] = r.scheme;
+    if (!r.closure.empty()) j["closure"] = r.closure;
   } else {
     j["method"] = "discrete flow (Newton per step)";
     j["backend"] = "lpshoot step Newton";
@@ -281,13 +282,14 @@ Written write_sweep(const Scene& scene, const SweepRecord& sw, const std::string
   ensure_dir(dir);
   Written w;
   // The CSV carries the solver as text columns; build it by hand.
-  std::string s = "N,h,method,backend,segments,converged,error,order,cost,cost_error,wall_time_s,iterations,momentum_drift\n";
+  std::string s = "N,h,scheme,method,backend,segments,converged,error,order,cost,cost_error,wall_time_s,iterations,"
+                  "momentum_drift\n";
   for (size_t i = 0; i < sw.runs.size(); ++i) {
     const auto& r = sw.runs[i];
-    s += std::to_string(r.N) + "," + number(r.h) + "," + r.method + "," + r.backend + "," + std::to_string(r.segments) +
-         "," + (r.converged ? "1" : "0") + "," + number(r.error) + "," + number(r.order) + "," + number(r.cost) + "," +
-         number(r.cost_error) + "," + number(r.wall_time_s) + "," + std::to_string(r.iterations) + "," +
-         number(r.momentum_drift) + "\n";
+    s += std::to_string(r.N) + "," + number(r.h) + "," + r.scheme + "," + r.method + "," + r.backend + "," +
+         std::to_string(r.segments) + "," + (r.converged ? "1" : "0") + "," + number(r.error) + "," + number(r.order) + "," +
+         number(r.cost) + "," + number(r.cost_error) + "," + number(r.wall_time_s) + "," + std::to_string(r.iterations) +
+         "," + number(r.momentum_drift) + "\n";
   }
   write_atomic(dir, "sweep.csv", s);
   w.files.push_back((dir / "sweep.csv").string());
@@ -297,17 +299,20 @@ Written write_sweep(const Scene& scene, const SweepRecord& sw, const std::string
       << "set datafile separator ','\nset grid\nset logscale xy\nset format y '10^{%L}'\n"
       << gp_header("sweep_error_time.png", 900, 600) << "set xlabel 'wall time [s]'\nset ylabel 'max error vs "
       << (sw.reference.rfind("exact", 0) == 0 ? "exact solution" : "finest grid") << "'\n"
-      << "set title '" << sw.problem << ": error against cost (labels: N)'\n";
-    std::vector<std::string> solvers;
+      << "set title '" << sw.problem << ": error against cost (labels: N)'\nset key top right\n";
+    // One line per scheme and solver: columns 3-5 (scheme, method, backend), error 8, time 12.
+    std::vector<std::string> lines;
     for (const auto& r : sw.runs)
-      if (std::find(solvers.begin(), solvers.end(), r.method + "," + r.backend) == solvers.end())
-        solvers.push_back(r.method + "," + r.backend);
+      if (const std::string key = r.scheme + "," + r.method + "," + r.backend;
+          std::find(lines.begin(), lines.end(), key) == lines.end())
+        lines.push_back(key);
     g << "plot ";
-    for (size_t i = 0; i < solvers.size(); ++i) {
-      const std::string sel = "(strcol(3).','.strcol(4) eq '" + solvers[i] + "' ? column(7) : NaN)";
-      const std::string name = solvers[i] == "," ? "discrete flow" : solvers[i];
-      g << (i ? ", " : "") << "'sweep.csv' skip 1 using 11:" << sel << " with linespoints lw 2 pt 7 title '" << name
-        << "', '' skip 1 using 11:" << sel << ":1 with labels offset 0,1 notitle";
+    for (size_t i = 0; i < lines.size(); ++i) {
+      const std::string sel = "(strcol(3).','.strcol(4).','.strcol(5) eq '" + lines[i] + "' ? column(8) : NaN)";
+      std::string name = lines[i] == ",," ? "discrete flow" : lines[i];
+      std::replace(name.begin(), name.end(), ',', ' ');
+      g << (i ? ", " : "") << "'sweep.csv' skip 1 using 12:" << sel << " with linespoints lw 2 pt 7 title '" << name
+        << "', '' skip 1 using 12:" << sel << ":1 with labels offset 0,1 notitle";
     }
     g << "\nset output\n";
     run_gnuplot(dir, g.str(), {"sweep_error_time.png"}, w);
@@ -325,7 +330,8 @@ Written write_sweep(const Scene& scene, const SweepRecord& sw, const std::string
     json x;
     x["N"] = r.N;
     x["h"] = r.h;
-    if (!r.method.empty()) x["method"] = r.method, x["backend"] = r.backend, x["segments"] = r.segments;
+    if (!r.method.empty())
+      x["scheme"] = r.scheme, x["method"] = r.method, x["backend"] = r.backend, x["segments"] = r.segments;
     x["status"] = r.status;
     x["converged"] = r.converged;
     if (!r.converged) x["message"] = r.message;

@@ -9,6 +9,13 @@ namespace lpshoot::app {
 
 std::string check_boundary(const Scene& s) {
   try {
+    // Counting does not depend on the Galerkin degree: the cubic scheme's problem stands for all.
+    if (s.galerkin() && s.problem == ProblemKind::Electron)
+      return check_counting(problems::electron_galerkin_bvp<3>(problems::model_of(s.electron), s.T, s.N, s.electron_start,
+                                                               s.electron_end));
+    if (s.galerkin() && s.problem == ProblemKind::Beanie)
+      return check_counting(problems::beanie_galerkin_bvp<3>(problems::BeanieModel{s.beanie}, s.T, s.N, s.beanie_start,
+                                                             s.beanie_end));
     if (s.problem == ProblemKind::Electron)
       return check_counting(problems::electron_bvp(s.electron, s.T, s.N, s.electron_start, s.electron_end, s.closure));
     if (s.problem == ProblemKind::Beanie) {
@@ -33,8 +40,12 @@ RunRecord run_one(const std::string& command, const Scene& s, const Progress& pr
     return simulate_beanie_free(s, progress);
   }
   switch (s.problem) {
-    case ProblemKind::Electron: return solve_electron(s, progress);
-    case ProblemKind::Beanie: return solve_beanie(s, progress);
+    case ProblemKind::Electron:
+      if (!s.galerkin()) return solve_electron(s, progress);
+      return s.galerkin_order == 6 ? solve_electron_galerkin_on<4>(s, progress) : solve_electron_galerkin_on<3>(s, progress);
+    case ProblemKind::Beanie:
+      if (!s.galerkin()) return solve_beanie(s, progress);
+      return s.galerkin_order == 6 ? solve_beanie_galerkin_on<4>(s, progress) : solve_beanie_galerkin_on<3>(s, progress);
     case ProblemKind::BeanieFree:
       throw SceneError(s.file + ": problem: \"beanie_free\" is a simulation from initial data: run `lpshoot simulate` on it");
   }
@@ -61,8 +72,7 @@ void estimate_error(const Scene& s, RunRecord& r, const Progress& progress) {
     Scene c = s;
     c.N = s.N / f;
     c.error_estimate = false;
-    c.shooting.segments = c.auto_segments ? auto_segments(c.N, c.order())
-                                          : std::clamp(s.shooting.segments / f, 1, c.N - 2 * c.order() + 1);
+    c.shooting.segments = c.auto_segments ? c.default_segments(c.N) : std::clamp(s.shooting.segments / f, 1, c.max_segments(c.N));
     if (progress) progress("error estimate: solving on N = " + std::to_string(c.N));
     coarse.push_back(run_one("solve", c, Progress()));
     if (!coarse.back().converged) {  // the run itself stands; only its estimate is missing

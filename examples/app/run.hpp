@@ -37,6 +37,7 @@ struct RunRecord {
   int N = 0;
   double T = 0, h = 0;
   std::string method, backend, closure, constraints;  // empty when not applicable
+  std::string scheme;  // "paper" or "galerkin4" or "galerkin6" (Scene::scheme_name); empty for a simulation
   int segments = 1;
   bool propagated_starts = false;  // multiple shooting began from the forward sweep (SegmentStarts)
   double tolerance = 0;
@@ -89,6 +90,12 @@ using Progress = std::function<void(const std::string&)>;
 
 RunRecord solve_electron(const Scene& s, const Progress& progress);
 RunRecord solve_beanie(const Scene& s, const Progress& progress);
+// scheme.discretization "galerkin" with Hermite degree S (order 2S - 2); instantiated for S = 3, 4
+// in run_{electron,beanie}_galerkin{4,6}.cpp.
+template <int S>
+RunRecord solve_electron_galerkin_on(const Scene& s, const Progress& progress);
+template <int S>
+RunRecord solve_beanie_galerkin_on(const Scene& s, const Progress& progress);
 RunRecord simulate_beanie_free(const Scene& s, const Progress& progress);
 
 // Why the scene's boundary value problem is ill-posed by counting (METHOD.md §5), or "".

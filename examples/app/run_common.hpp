@@ -30,7 +30,8 @@ inline RunRecord start_record(const std::string& command, const Scene& s) {
 inline void describe_solver(const Scene& s, RunRecord& r) {
   r.method = method_name(s.shooting.method);
   r.backend = backend_name(s.shooting.solver.backend);
-  r.closure = closure_name(s.closure);
+  r.scheme = s.scheme_name();
+  if (!s.galerkin()) r.closure = closure_name(s.closure);
   r.segments = s.shooting.method == ShootingMethod::Multiple ? s.shooting.segments : 1;
   r.tolerance = s.shooting.solver.tolerance;
 }
@@ -47,15 +48,16 @@ inline ShootingOptions options_with_progress(const Scene& s, const Progress& pro
   return opt;
 }
 
-// Solves the scene's boundary value problem (make: Scene -> BoundaryValueProblem<P>; guess:
-// problem -> ShootingGuess<P>), through solver.continuation when the scene asks for it. The
-// continuation record goes into r.
+// Solves the scene's boundary value problem (make: Scene -> the scheme's BVP, guess: BVP -> the
+// scheme's guess; P the paper's problem or a Galerkin scheme), through solver.continuation when
+// the scene asks for it. The continuation record goes into r.
 template <class P, class Make, class Guess>
 ShootingResult<P> solve_scene(const Scene& s, const Make& make, const Guess& guess, const Progress& progress,
                               RunRecord& r) {
+  using BVP = typename SchemeFor<P>::BVP;
   const ShootingOptions opt = options_with_progress(s, progress);
   if (!s.continuation) {
-    const BoundaryValueProblem<P> bvp = make(s);
+    const BVP bvp = make(s);
     return solve_bvp(bvp, guess(bvp), opt);
   }
   const Scene::Continuation& c = *s.continuation;
@@ -70,7 +72,7 @@ ShootingResult<P> solve_scene(const Scene& s, const Make& make, const Guess& gue
                     ok ? "solved" : "failed, step halved", iterations);
       progress(buf);
     };
-  const BoundaryValueProblem<P> first = at(c.from);
+  const BVP first = at(c.from);
   ContinuationResult<P> cont = continuation<P>(at, c.from, c.to, guess(first), opt, copt);
   r.continuation_parameter = c.parameter;
   r.continuation_path = cont.path;

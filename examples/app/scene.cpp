@@ -219,17 +219,17 @@ void read_solver(const Reader& r, Scene& s) {
   }
   r.allow({"method", "segments", "backend", "tolerance", "max_iterations", "threads", "continuation"});
   s.shooting.method = read_method(r.choice("method", {"single", "multiple"}, "single"));
-  const int max_segments = s.N - 2 * s.order() + 1;
+  const int max_segments = s.max_segments(s.N);
   s.auto_segments = !r.has("segments") || r.at("segments").is_string();
   if (s.auto_segments) {
     if (r.has("segments") && r.at("segments").get<std::string>() != "auto")
       r.fail("must be an integer or \"auto\" (got " + r.at("segments").dump() + ")", "segments");
-    s.shooting.segments = auto_segments(s.N, s.order());
+    s.shooting.segments = s.default_segments(s.N);
   } else {
     s.shooting.segments = r.integer("segments", 1);
   }
   if (s.shooting.segments < 1 || s.shooting.segments > max_segments)
-    r.fail("must be between 1 and N - 2k + 1 = " + std::to_string(max_segments) + " (got " +
+    r.fail("must be between 1 and " + std::string(s.galerkin() ? "N = " : "N - 2k + 1 = ") + std::to_string(max_segments) + " (got " +
                std::to_string(s.shooting.segments) + ")",
            "segments");
   if (s.shooting.method == ShootingMethod::Single) s.shooting.segments = 1;  // segments: multiple shooting only
@@ -397,6 +397,41 @@ Scene with_parameter(const Scene& s, const std::string& parameter, double value)
 
 namespace {
 
+// scheme: the discretization and its options. closure and constraints belong to the paper's
+// nodal windows; order to Galerkin (METHOD.md §9).
+void read_scheme(const Reader& sc, Scene& s) {
+  if (s.problem == ProblemKind::BeanieFree) {
+    sc.allow({});
+    return;
+  }
+  std::vector<std::string> keys = {"discretization", "order", "closure", "error_estimate"};
+  if (s.problem == ProblemKind::Beanie) keys.push_back("constraints");
+  sc.allow(keys);
+  s.error_estimate = sc.boolean("error_estimate", false);
+  s.discretization =
+      sc.choice("discretization", {"paper", "galerkin"}, "paper") == "galerkin" ? Discretization::Galerkin : Discretization::Paper;
+  if (s.galerkin()) {
+    for (const char* key : {"closure", "constraints"})
+      if (sc.has(key))
+        sc.fail("applies to the paper's discretization only (Galerkin imposes node positions and velocities exactly "
+                "and the continuous constraints at its Gauss points); remove it",
+                key);
+    s.galerkin_order = sc.integer("order", 4);
+    if (s.galerkin_order != 4 && s.galerkin_order != 6)
+      sc.fail("must be 4 or 6 (cubic or quartic Galerkin; got " + std::to_string(s.galerkin_order) + ")", "order");
+    return;
+  }
+  if (sc.has("order"))
+    sc.fail("applies to the galerkin discretization only (the paper's order follows from its closure); remove it or set "
+            "scheme.discretization = \"galerkin\"",
+            "order");
+  s.closure = sc.choice("closure", {"paper", "second_order"}, "second_order") == "paper" ? Closure::Paper : Closure::SecondOrder;
+  if (s.problem == ProblemKind::Beanie)
+    s.constraints = sc.choice("constraints", {"paper", "exact_rotation"}, "exact_rotation") == "paper"
+                        ? problems::BeanieConstraints::Paper
+                        : problems::BeanieConstraints::ExactRotation;
+}
+
 Scene parse_scene(const json& j, const std::string& path) {
   Scene s;
   s.file = path;
@@ -417,11 +452,6 @@ Scene parse_scene(const json& j, const std::string& path) {
   if (!(s.T > 0)) hz.fail("must be > 0 (got " + Reader::format(s.T) + ")", "T");
   if (!hz.has("N")) hz.fail("missing (required)", "N");
   s.N = hz.integer("N", 0);
-  const int k = s.order();
-  if (s.N < 2 * k + 1)
-    hz.fail("must be at least 2k + 1 = " + std::to_string(2 * k + 1) + " for " + s.problem_name + " (order k = " +
-                std::to_string(k) + "; got " + std::to_string(s.N) + ")",
-            "N");
 
   switch (s.problem) {
     case ProblemKind::Electron: read_electron(root, s); break;
@@ -429,25 +459,19 @@ Scene parse_scene(const json& j, const std::string& path) {
     case ProblemKind::BeanieFree: read_beanie_free(root, s); break;
   }
 
-  if (const auto sc = root.optional_object("scheme")) {
-    if (s.problem == ProblemKind::BeanieFree) {
-      sc->allow({});
-    } else {
-      sc->allow(s.problem == ProblemKind::Beanie ? std::vector<std::string>{"closure", "constraints", "error_estimate"}
-                                                 : std::vector<std::string>{"closure", "error_estimate"});
-      s.error_estimate = sc->boolean("error_estimate", false);
-      if (s.error_estimate && (s.N % 4 != 0 || s.N / 4 < 2 * k + 1))
-        sc->fail("needs N divisible by 4 with N/4 >= 2k + 1 = " + std::to_string(2 * k + 1) +
-                     " (the estimate solves on N/2 and N/4 too; N = " + std::to_string(s.N) + ")",
-                 "error_estimate");
-      s.closure = sc->choice("closure", {"paper", "second_order"}, "second_order") == "paper" ? Closure::Paper
-                                                                                               : Closure::SecondOrder;
-      if (s.problem == ProblemKind::Beanie)
-        s.constraints = sc->choice("constraints", {"paper", "exact_rotation"}, "exact_rotation") == "paper"
-                            ? problems::BeanieConstraints::Paper
-                            : problems::BeanieConstraints::ExactRotation;
-    }
+  const auto sc = root.optional_object("scheme");
+  if (sc) read_scheme(*sc, s);
+  const int k = s.order();
+  if (s.N < s.min_N()) {
+    if (s.galerkin()) hz.fail("must be at least 2 for the galerkin discretization (got " + std::to_string(s.N) + ")", "N");
+    hz.fail("must be at least 2k + 1 = " + std::to_string(2 * k + 1) + " for " + s.problem_name + " (order k = " +
+                std::to_string(k) + "; got " + std::to_string(s.N) + ")",
+            "N");
   }
+  if (s.error_estimate && (s.N % 4 != 0 || s.N / 4 < s.min_N()))
+    sc->fail("needs N divisible by 4 with N/4 >= " + std::to_string(s.min_N()) +
+                 " (the estimate solves on N/2 and N/4 too; N = " + std::to_string(s.N) + ")",
+             "error_estimate");
   if (const auto so = root.optional_object("solver")) {
     read_solver(*so, s);
     read_continuation(*so, j, s);
@@ -466,6 +490,20 @@ Scene parse_scene(const json& j, const std::string& path) {
 }
 
 }  // namespace
+
+bool set_scheme(Scene& s, const std::string& name) {
+  if (name == "paper") {
+    s.discretization = Discretization::Paper;
+    return true;
+  }
+  for (int order : {4, 6})
+    if (name == "galerkin" + std::to_string(order)) {
+      s.discretization = Discretization::Galerkin;
+      s.galerkin_order = order;
+      return true;
+    }
+  return false;
+}
 
 const char* closure_name(Closure c) { return c == Closure::Paper ? "paper" : "second_order"; }
 const char* constraints_name(problems::BeanieConstraints c) {

@@ -20,6 +20,10 @@ struct SceneError : std::runtime_error {
 
 enum class ProblemKind { Electron, Beanie, BeanieFree };
 
+// scheme.discretization: the paper's nodal windows (with a closure), or Galerkin on node states
+// of order 4 or 6 (METHOD.md §9; the library has order 8 too).
+enum class Discretization { Paper, Galerkin };
+
 // Free-motion beanie initial data: q_0, q_1 directly, or a position and velocity
 // (q_1 = q_0 + h q'(0), the paper's first-order closure).
 struct BeanieFreeInitial {
@@ -35,11 +39,13 @@ struct Scene {
   double T = 1.0;
   int N = 100;
 
+  Discretization discretization = Discretization::Paper;
+  int galerkin_order = 4;  // scheme.order (Galerkin only): 4 or 6
   Closure closure = Closure::SecondOrder;
   problems::BeanieConstraints constraints = problems::BeanieConstraints::ExactRotation;
   ShootingOptions shooting;
   bool auto_segments = true;
-  bool error_estimate = false;  // scheme.error_estimate: also solve on N/2 and N/4 (run.cpp)  // solver.segments "auto" (the default): see auto_segments()
+  bool error_estimate = false;  // scheme.error_estimate: also solve on N/2 and N/4 (run.cpp)
 
   // solver.continuation: solve at parameters.<parameter> = from first, then step towards the
   // scene's own value, each solve starting from the last solution (shooting/continuation.hpp).
@@ -63,12 +69,22 @@ struct Scene {
   int order() const { return problem == ProblemKind::BeanieFree ? 1 : 2; }
   double h() const { return T / N; }
   bool is_optimal_control() const { return problem != ProblemKind::BeanieFree; }
+  bool galerkin() const { return discretization == Discretization::Galerkin; }
+  // The smallest grid the scheme accepts: 2k + 1 nodes for the paper's windows, 2 intervals for Galerkin.
+  int min_N() const { return galerkin() ? 2 : 2 * order() + 1; }
+  // Multiple shooting's segment count: at most N - 2k + 1 (paper) or N (Galerkin).
+  int max_segments(int n) const { return galerkin() ? n : n - 2 * order() + 1; }
+  // solver.segments "auto": segments of at most 100 steps. A k = 2 recursion rounds its nodal
+  // states each step and amplifies that like L^4 eps over L steps (METHOD.md §5); 100 steps keep
+  // it near 1e-8 of the state's size, and the segment count grows only with N. (Galerkin states
+  // do not amplify roundoff that way; 100 steps still bound the growth of unstable flows.)
+  int default_segments(int n) const { return std::clamp((n + 99) / 100, 1, max_segments(n)); }
+  // "paper", "galerkin4" or "galerkin6": the names `sweep --scheme` takes.
+  std::string scheme_name() const { return galerkin() ? "galerkin" + std::to_string(galerkin_order) : "paper"; }
 };
 
-// Multiple shooting's default segment count: segments of at most 100 steps. A k = 2 recursion
-// rounds its nodal states each step and amplifies that like L^4 eps over L steps (METHOD.md §5);
-// 100 steps keep it near 1e-8 of the state's size, and the segment count grows only with N.
-inline int auto_segments(int N, int k) { return std::clamp((N + 99) / 100, 1, N - 2 * k + 1); }
+// Sets the scheme from a name scheme_name() gives; false for an unknown name.
+bool set_scheme(Scene& s, const std::string& name);
 
 // Reads, applies the --set overrides ("key.path=value", value parsed as JSON when it is JSON,
 // else taken as a string; "null" removes the key), validates. Throws SceneError.

@@ -39,62 +39,75 @@ SweepRecord run_sweep(const Scene& scene, const std::string& command, const Swee
   std::vector<int> grids = opt.N;
   std::sort(grids.begin(), grids.end());
   grids.erase(std::unique(grids.begin(), grids.end()), grids.end());
-  const int k = scene.order();
-  if (grids.empty()) throw SceneError("--N: give at least one grid (e.g. --N 50,100,200)");
-  if (grids.front() < 2 * k + 1)
-    throw SceneError("--N: every N must be at least 2k + 1 = " + std::to_string(2 * k + 1) + " for " +
-                     scene.problem_name + " (got " + std::to_string(grids.front()) + ")");
   if (scene.problem == ProblemKind::BeanieFree && scene.beanie_free.configurations)
     throw SceneError(scene.file + ": boundary.initial.configurations: q_0, q_1 belong to one grid; a sweep needs "
                                   "initial data as position and velocity");
-  // Solvers (simulations have none to choose) in the outer loop, grids coarse to fine.
+  // The schemes (each a copy of the scene), solvers (simulations have none to choose), grids
+  // coarse to fine, in that nesting.
+  std::vector<Scene> schemes;
+  for (const std::string& name : opt.schemes) {
+    Scene sc = scene;
+    if (!scene.is_optimal_control() || !set_scheme(sc, name))
+      throw SceneError("--scheme: '" + name + "' is not a scheme of " + scene.problem_name +
+                       (scene.is_optimal_control() ? " (paper, galerkin4, galerkin6)" : " (a simulation has one scheme)"));
+    schemes.push_back(sc);
+  }
+  if (schemes.empty()) schemes.push_back(scene);
+  for (const Scene& sc : schemes)
+    if (grids.front() < sc.min_N())
+      throw SceneError("--N: every N must be at least " +
+                       (sc.galerkin() ? std::string("2 for ") + sc.scheme_name()
+                                      : "2k + 1 = " + std::to_string(sc.min_N()) + " for " + scene.problem_name) +
+                       " (got " + std::to_string(grids.front()) + ")");
   std::vector<std::pair<ShootingMethod, Backend>> solvers;
   for (ShootingMethod m : opt.methods.empty() ? std::vector{scene.shooting.method} : opt.methods)
     for (Backend b : opt.backends.empty() ? std::vector{scene.shooting.solver.backend} : opt.backends)
       if (scene.is_optimal_control() || solvers.empty()) solvers.emplace_back(m, b);
+  const size_t total = schemes.size() * solvers.size() * grids.size();
   std::vector<RunRecord> full;
-  for (const auto& [m, b] : solvers)
-    for (int N : grids) {
-      Scene s = scene;
-      s.N = N;
-      s.error_estimate = false;  // the sweep measures errors itself
-      SweepRun sr;
-      sr.N = N;
-      sr.h = s.h();
-      std::string label = "N = " + std::to_string(N);
-      if (scene.is_optimal_control()) {
-        s.shooting.method = m;
-        s.shooting.solver.backend = b;
-        int segments = scene.shooting.segments;
-        if (opt.steps_per_segment > 0)
-          segments = (N + opt.steps_per_segment - 1) / opt.steps_per_segment;
-        else if (scene.auto_segments || scene.shooting.method == ShootingMethod::Single)
-          segments = auto_segments(N, k);  // per grid (a single-shooting scene: multiple shooting's default)
-        s.shooting.segments = std::clamp(segments, 1, N - 2 * k + 1);
-        sr.method = method_name(m);
-        sr.backend = backend_name(b);
-        sr.segments = m == ShootingMethod::Multiple ? s.shooting.segments : 1;
-        label += ", " + sr.method + " shooting" +
-                 (m == ShootingMethod::Multiple ? " (" + std::to_string(sr.segments) + " segments)" : "") + ", " +
-                 sr.backend;
+  for (const Scene& base : schemes)
+    for (const auto& [m, b] : solvers)
+      for (int N : grids) {
+        Scene s = base;
+        s.N = N;
+        s.error_estimate = false;  // the sweep measures errors itself
+        SweepRun sr;
+        sr.N = N;
+        sr.h = s.h();
+        std::string label = "N = " + std::to_string(N);
+        if (scene.is_optimal_control()) {
+          s.shooting.method = m;
+          s.shooting.solver.backend = b;
+          int segments = scene.shooting.segments;
+          if (opt.steps_per_segment > 0)
+            segments = (N + opt.steps_per_segment - 1) / opt.steps_per_segment;
+          else if (scene.auto_segments || scene.shooting.method == ShootingMethod::Single)
+            segments = s.default_segments(N);  // per grid (a single-shooting scene: multiple shooting's default)
+          s.shooting.segments = std::clamp(segments, 1, s.max_segments(N));
+          sr.scheme = s.scheme_name();
+          sr.method = method_name(m);
+          sr.backend = backend_name(b);
+          sr.segments = m == ShootingMethod::Multiple ? s.shooting.segments : 1;
+          label += ", " + sr.scheme + ", " + sr.method + " shooting" +
+                   (m == ShootingMethod::Multiple ? " (" + std::to_string(sr.segments) + " segments)" : "") + ", " +
+                   sr.backend;
+        }
+        if (progress) progress("[" + std::to_string(full.size() + 1) + "/" + std::to_string(total) + "] " + label);
+        full.push_back(run_scene(command, s, Progress()));
+        const RunRecord& r = full.back();
+        sr.converged = r.converged;
+        sr.status = r.status;
+        sr.message = r.message;
+        sr.iterations = r.iterations;
+        sr.wall_time_s = r.wall_time_s;
+        sr.momentum_drift = r.momentum_drift;
+        if (r.has_cost) sr.cost = r.cost;
+        rec.runs.push_back(sr);
+        if (!r.converged && rec.all_converged) {
+          rec.all_converged = false;
+          rec.message = label + ": " + r.status + ": " + r.message;
+        }
       }
-      if (progress)
-        progress("[" + std::to_string(full.size() + 1) + "/" + std::to_string(solvers.size() * grids.size()) + "] " + label);
-      full.push_back(run_scene(command, s, Progress()));
-      const RunRecord& r = full.back();
-      sr.converged = r.converged;
-      sr.status = r.status;
-      sr.message = r.message;
-      sr.iterations = r.iterations;
-      sr.wall_time_s = r.wall_time_s;
-      sr.momentum_drift = r.momentum_drift;
-      if (r.has_cost) sr.cost = r.cost;
-      rec.runs.push_back(sr);
-      if (!r.converged && rec.all_converged) {
-        rec.all_converged = false;
-        rec.message = label + ": " + r.status + ": " + r.message;
-      }
-    }
 
   // Reference: the exact oracle, else the finest grid of the first solver.
   for (const auto& r : full)
@@ -107,10 +120,15 @@ SweepRecord run_sweep(const Scene& scene, const std::string& command, const Swee
     rec.reference = "exact continuous optimum (matrix exponential)";
     ref_cost = exact.cost;
   } else {
-    ref_index = grids.size() - 1;  // the first solver's finest run
+    // The first solver's finest run of the highest-order scheme (paper: order 2 at best).
+    size_t best = 0;
+    for (size_t i = 1; i < schemes.size(); ++i)
+      if ((schemes[i].galerkin() ? schemes[i].galerkin_order : 2) > (schemes[best].galerkin() ? schemes[best].galerkin_order : 2))
+        best = i;
+    ref_index = (best * solvers.size() + 1) * grids.size() - 1;
+    const SweepRun& rr = rec.runs[ref_index];
     rec.reference = "finest grid (N = " + std::to_string(grids.back()) + ", " +
-                    (rec.runs[ref_index].method.empty() ? std::string("discrete flow")
-                                                        : rec.runs[ref_index].method + " shooting, " + rec.runs[ref_index].backend) +
+                    (rr.method.empty() ? std::string("discrete flow") : rr.scheme + ", " + rr.method + " shooting, " + rr.backend) +
                     ")";
     if (full[ref_index].converged) {
       ref = full[ref_index].trajectory;
@@ -133,7 +151,8 @@ SweepRecord run_sweep(const Scene& scene, const std::string& command, const Swee
     SweepRun &a = rec.runs[i - 1], &b = rec.runs[i];
     // On the reference grid itself the error measures the solvers' disagreement, not the scheme.
     const bool on_reference_grid = !exact.available && b.N == grids.back();
-    if (a.method == b.method && a.backend == b.backend && a.N < b.N && a.error > 0 && b.error > 0 && !on_reference_grid)
+    if (a.scheme == b.scheme && a.method == b.method && a.backend == b.backend && a.N < b.N && a.error > 0 && b.error > 0 &&
+        !on_reference_grid)
       b.order = std::log(a.error / b.error) / std::log(double(b.N) / a.N);
   }
   return rec;

@@ -8,6 +8,7 @@ namespace lpshoot::app {
 
 struct SweepOptions {
   std::vector<int> N;                    // grids, any order
+  std::vector<std::string> schemes;      // "paper", "galerkin4", ... (Scene::scheme_name); empty: the scene's
   std::vector<ShootingMethod> methods;   // empty: the scene's
   std::vector<Backend> backends;         // empty: the scene's
   int steps_per_segment = 0;             // > 0: multiple shooting segments = ceil(N / this)
@@ -17,7 +18,7 @@ struct SweepOptions {
 struct SweepRun {
   int N = 0, segments = 1, iterations = 0;
   double h = 0;
-  std::string method, backend, status, message;
+  std::string scheme, method, backend, status, message;
   bool converged = false;
   double error = nan();       // max over nodes and state columns of |run - reference|
   double order = nan();       // against the previous grid of the same solver
@@ -33,7 +34,8 @@ struct SweepRecord {
   std::string message;  // the first failure, when any
 };
 
-// Throws SceneError for an N list that does not fit the scene.
+// Throws SceneError for an N list or a scheme name that does not fit the scene. With several
+// schemes and no exact oracle, the reference is the finest grid of the highest-order scheme.
 SweepRecord run_sweep(const Scene& scene, const std::string& command, const SweepOptions& opt, const Progress& progress);
 
 }  // namespace lpshoot::app

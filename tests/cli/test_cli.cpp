@@ -185,6 +185,22 @@ TEST(ExampleScenes, BeanieFree) {
   for (size_t n = 0; n + 1 < rows.size(); ++n) EXPECT_NEAR(rows[n][7], rows[0][7], 1e-12);
 }
 
+TEST(ExampleScenes, BeanieOnTheOrderSixGalerkinScheme) {
+  const fs::path out = scratch("beanie_galerkin") / "out";
+  const json report = run_example("beanie_galerkin", out);
+  EXPECT_EQ(report["scheme"], "galerkin6");
+  EXPECT_FALSE(report.contains("closure"));
+  std::vector<std::string> header;
+  const auto rows = read_csv(out / "trajectory.csv", header);
+  EXPECT_EQ(header, (std::vector<std::string>{"t", "psi", "theta", "x", "y", "Omega1", "Omega2", "Omega3", "psi_dot", "u"}));
+  // Node data are imposed exactly: Ω12(0), ψ'(T) and θ(T) to the solver's tolerance.
+  EXPECT_NEAR(rows.front()[5], 0.5, 1e-10);
+  EXPECT_NEAR(rows.back()[8], 0.0, 1e-9);
+  EXPECT_NEAR(rows.back()[2], 1.0, 1e-10);
+  // The control at every node (discrete Legendre transform), finite.
+  for (const auto& r : rows) EXPECT_TRUE(std::isfinite(r[9]));
+}
+
 TEST(ExampleScenes, UnstableElectronMultipleShooting) {
   run_example("electron_unstable", scratch("electron_unstable") / "out");
 }
@@ -324,6 +340,45 @@ TEST(Sweep, ElectronOrdersAgainstTheExactOptimum) {
   }
 }
 
+TEST(Sweep, GalerkinSchemesReachOrdersFourAndSixAgainstTheExactOptimum) {
+  // METHOD.md §9: the cubic and quartic Galerkin schemes converge at orders 4 and 6 in the node
+  // positions and in the cost, to 1e-12 with no roundoff floor, where the paper's scheme is at 2.
+  const fs::path work = scratch("sweep_galerkin");
+  const Outcome o = run_cli("sweep '" + scene("electron") + "' --N 10,20,40 --scheme paper,galerkin4,galerkin6 --out '" +
+                                (work / "out").string() + "'", work);
+  ASSERT_EQ(o.code, 0) << o.out << o.err;
+  const json sw = json::parse(std::ifstream(work / "out" / "sweep.json"));
+  ASSERT_EQ(sw["runs"].size(), 9u);
+  for (size_t i = 0; i < 9; ++i) {
+    const json& r = sw["runs"][i];
+    EXPECT_EQ(r["scheme"], (std::vector<std::string>{"paper", "galerkin4", "galerkin6"})[i / 3]);
+    if (i % 3 == 0 || i == 1) continue;  // the paper's scheme is not yet asymptotic at N = 10
+    const double expected = i / 3 == 0 ? 2.0 : i / 3 == 1 ? 4.0 : 6.0;
+    EXPECT_NEAR(r["order"].get<double>(), expected, 0.2) << r.dump();
+    const double cost_order = std::log2(sw["runs"][i - 1]["cost_error"].get<double>() / r["cost_error"].get<double>());
+    if (i / 3 > 0) EXPECT_NEAR(cost_order, expected, 0.2) << r.dump();
+  }
+  EXPECT_LT(sw["runs"][8]["error"].get<double>(), 1e-12);
+  EXPECT_EQ(slurp(work / "out" / "sweep.csv").rfind("N,h,scheme,method,backend,", 0), 0u);
+  if (gnuplot_available()) {
+    EXPECT_TRUE(is_png(work / "out" / "sweep_error_time.png"));
+  }
+}
+
+TEST(ErrorEstimate, GalerkinBeanieObservesOrderFour) {
+  // No exact answer for the beanie: Richardson on N, N/2, N/4 sees the scheme's order, and the
+  // mechanical momentum of the free beanie is conserved along the optimal motion.
+  const fs::path work = scratch("estimate_galerkin");
+  const Outcome o = run_cli("solve '" + scene("beanie") +
+                                "' --no-plot --set 'scheme={\"discretization\": \"galerkin\", \"error_estimate\": true}' "
+                                "--set horizon.N=40 --out '" + (work / "out").string() + "'", work);
+  ASSERT_EQ(o.code, 0) << o.out << o.err;
+  const json report = json::parse(std::ifstream(work / "out" / "report.json"));
+  EXPECT_EQ(report["scheme"], "galerkin4");
+  EXPECT_NEAR(report["error_estimate"]["observed_order"].get<double>(), 4.0, 0.2);
+  EXPECT_LT(report["error_estimate"]["value"].get<double>(), 1e-6);
+}
+
 TEST(Sweep, SolversAgreeOnTheFinestGrid) {
   const fs::path work = scratch("sweep_solvers");
   const Outcome o = run_cli("sweep '" + scene("beanie") + "' --N 100,200 --method single,multiple --backend kinsol,nlopt --no-plot --out '" +
@@ -421,6 +476,15 @@ TEST_F(BadInput, EachClassFailsCleanlyNamingTheKey) {
       {"wrong_command", "simulate " + e, "run `lpshoot solve` on it"},
       {"malformed_set", "solve " + e + "--set horizon.N", "--set 'horizon.N': expected key.path=value"},
       {"sweep_small_N", "sweep " + e + "--N 3,50", "--N: every N must be at least 2k + 1 = 5"},
+      {"galerkin_order", "solve " + e + "--set 'scheme={\"discretization\": \"galerkin\", \"order\": 5}'",
+       "scheme.order: must be 4 or 6"},
+      {"closure_with_galerkin", "solve " + e + "--set scheme.discretization=galerkin",
+       "scheme.closure: applies to the paper's discretization only"},
+      {"order_with_paper", "solve " + e + "--set scheme.order=4", "scheme.order: applies to the galerkin discretization only"},
+      {"galerkin_small_N", "solve " + e + "--set 'scheme={\"discretization\": \"galerkin\"}' --set horizon.N=1",
+       "horizon.N: must be at least 2 for the galerkin discretization"},
+      {"galerkin_segments", "solve " + e + "--set 'scheme={\"discretization\": \"galerkin\"}' --set solver.segments=201",
+       "solver.segments: must be between 1 and N = 200"},
       {"unwritable_out", "", "cannot create the output directory", 3},
   };
   for (const BadCase& c : cases) {
@@ -447,7 +511,7 @@ TEST_F(BadInput, InvalidJsonNamesTheLine) {
 
 TEST_F(BadInput, CheckAcceptsEveryExampleScene) {
   const fs::path work = scratch("check");
-  for (const char* name : {"electron", "beanie", "beanie_free", "electron_unstable"}) {
+  for (const char* name : {"electron", "beanie", "beanie_free", "electron_unstable", "beanie_galerkin"}) {
     const Outcome o = run_cli(std::string("check '") + scene(name) + "'", work);
     EXPECT_EQ(o.code, 0) << name << ": " << o.err;
     EXPECT_NE(o.out.find("valid"), std::string::npos);
