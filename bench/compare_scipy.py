@@ -1,16 +1,24 @@
 #!/usr/bin/python3
-"""Accuracy per unit time on the paper's electron (METHOD.md 6.1): lpshoot against scipy's
-solve_bvp, measured in the same run on the same machine.
+"""Accuracy per unit time on the paper's two examples: lpshoot's schemes (the paper's nodal
+windows, Galerkin of order 4 and 6) against scipy's solve_bvp, measured in the same run on the
+same machine.
 
-The continuous optimum is linear: y = (x, x', u, u') solves y' = A y, so the exact answer is
-expm(A t) y0 (computed here with scipy.linalg.expm, independently of lpshoot's C++ oracle).
-scipy solve_bvp (4th-order collocation) solves that 12-dimensional two-point problem directly;
-lpshoot solves the discrete variational problem (multiple shooting,
-second-order closure, the default segments of at most 100 steps) through `lpshoot sweep`, whose errors are against lpshoot's own exact
-oracle; one lpshoot trajectory is cross-checked here against the Python oracle.
+electron (METHOD.md 6.1): the continuous optimum is linear, y = (x, x', u, u') solves y' = A y;
+the exact answer is expm(A t) y0 (scipy.linalg.expm, independent of lpshoot's C++ oracle).
+beanie (METHOD.md 6.2): the group motion is fixed by the shape (Omega3 from theta(T), the centre
+moving with constant spatial velocity), so the optimum is the shape problem
+min int 1/2 u^2, u = mu psi'' + V'(psi), whose Euler-Lagrange equation is mu u'' + V''(psi) u = 0:
+y = (psi, psi', u, u'). Reference: shooting on (u(0), u'(0)) with DOP853 at rtol 1e-13
+(scipy.integrate.solve_ivp + scipy.optimize.fsolve), independent of lpshoot.
+
+scipy's solve_bvp (4th-order collocation) gets the continuous optimality system written by hand,
+with analytic fun_jac and bc_jac, vectorized; lpshoot gets the scene only (it derives its
+equations from the Lagrangian). Timed: the solve_bvp call; lpshoot's solve (wall_time_s of the
+report, not the process start). Error: max over lpshoot's nodes (scipy: over 401 points) of the
+positions (electron) or of psi, theta, x, y (beanie).
 
 usage: /usr/bin/python3 bench/compare_scipy.py [path/to/lpshoot] [repetitions]
-(needs python3-scipy; prints a Markdown table)
+(needs python3-scipy; prints Markdown tables)
 """
 import json
 import os
@@ -21,135 +29,194 @@ import tempfile
 import time
 
 import numpy as np
-from scipy.integrate import solve_bvp
+from scipy.integrate import solve_bvp, solve_ivp
 from scipy.linalg import expm
+from scipy.optimize import fsolve
 
 LPSHOOT = sys.argv[1] if len(sys.argv) > 1 else "build/examples/app/lpshoot"
 REPS = int(sys.argv[2]) if len(sys.argv) > 2 else 5
-SCENE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "examples", "scenes", "electron.json")
-
-with open(SCENE) as f:
-    scene = json.load(f)
-par, bd = scene["parameters"], scene["boundary"]
-m, ec, B, kappa = par["m"], par["e_over_c"], np.array(par["B"]), par["potential"]
-T = scene["horizon"]["T"]
-x0, v0 = np.array(bd["initial"]["position"]), np.array(bd["initial"]["velocity"])
-xT, vT = np.array(bd["final"]["position"]), np.array(bd["final"]["velocity"])
-
-# u = m x'' + K x' + 2 kappa x with K v = (e/c) B x v;  optimality: m u'' + K u' + 2 kappa u = 0.
-K = ec * np.array([[0, -B[2], B[1]], [B[2], 0, -B[0]], [-B[1], B[0], 0]])
-I3 = np.eye(3)
-A = np.zeros((12, 12))
-A[0:3, 3:6] = I3
-A[3:6, 0:3] = -(2 * kappa / m) * I3
-A[3:6, 3:6] = -K / m
-A[3:6, 6:9] = I3 / m
-A[6:9, 9:12] = I3
-A[9:12, 6:9] = -(2 * kappa / m) * I3
-A[9:12, 9:12] = -K / m
-Phi = expm(A * T)
-a, b = np.concatenate([x0, v0]), np.concatenate([xT, vT])
-y0 = np.concatenate([a, np.linalg.solve(Phi[:6, 6:], b - Phi[:6, :6] @ a)])
+SCENES = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "examples", "scenes")
+LEVELS = [1e-6, 1e-8, 1e-10]
+SCHEMES = {  # scheme name -> (scene "scheme" object, grids)
+    "paper": ({"closure": "second_order"}, [50, 100, 200, 400, 800, 1600, 3200]),
+    "galerkin4": ({"discretization": "galerkin", "order": 4}, [10, 20, 40, 80, 160, 320]),
+    "galerkin6": ({"discretization": "galerkin", "order": 6}, [4, 8, 16, 32, 64]),
+}
 
 
-def exact_x(ts):
-    return np.array([(expm(A * t) @ y0)[:3] for t in ts])
+def load(name):
+    with open(os.path.join(SCENES, name + ".json")) as f:
+        return json.load(f)
 
 
-check_t = np.linspace(0, T, 401)
-check_x = exact_x(check_t)
+class Electron:
+    name, scene, columns = "electron", "electron", ["x1", "x2", "x3"]
+
+    def __init__(self):
+        s = load(self.scene)
+        par, bd = s["parameters"], s["boundary"]
+        m, ec, B, kappa = par["m"], par["e_over_c"], np.array(par["B"]), par["potential"]
+        self.T = s["horizon"]["T"]
+        self.x0, self.v0 = np.array(bd["initial"]["position"]), np.array(bd["initial"]["velocity"])
+        self.xT, self.vT = np.array(bd["final"]["position"]), np.array(bd["final"]["velocity"])
+        # u = m x'' + K x' + 2 kappa x with K v = (e/c) B x v;  optimality: m u'' + K u' + 2 kappa u = 0.
+        K = ec * np.array([[0, -B[2], B[1]], [B[2], 0, -B[0]], [-B[1], B[0], 0]])
+        I3 = np.eye(3)
+        A = np.zeros((12, 12))
+        A[0:3, 3:6] = I3
+        A[3:6, 0:3] = -(2 * kappa / m) * I3
+        A[3:6, 3:6] = -K / m
+        A[3:6, 6:9] = I3 / m
+        A[6:9, 9:12] = I3
+        A[9:12, 6:9] = -(2 * kappa / m) * I3
+        A[9:12, 9:12] = -K / m
+        self.A = A
+        Phi = expm(A * self.T)
+        a, b = np.concatenate([self.x0, self.v0]), np.concatenate([self.xT, self.vT])
+        self.y0 = np.concatenate([a, np.linalg.solve(Phi[:6, 6:], b - Phi[:6, :6] @ a)])
+
+    def exact(self, ts):  # columns at times ts
+        return np.array([(expm(self.A * t) @ self.y0)[:3] for t in ts])
+
+    def scipy(self, tol):
+        A = self.A
+        fun = lambda t, y: A @ y
+        jac = lambda t, y: np.repeat(A[:, :, None], y.shape[1], axis=2)
+        I6 = np.eye(12)[:6]
+        bc = lambda ya, yb: np.concatenate([ya[:6] - np.concatenate([self.x0, self.v0]),
+                                            yb[:6] - np.concatenate([self.xT, self.vT])])
+        bc_jac = lambda ya, yb: (np.vstack([I6, np.zeros((6, 12))]), np.vstack([np.zeros((6, 12)), I6]))
+        mesh = np.linspace(0, self.T, 11)
+        return solve_bvp(fun, bc, mesh, np.zeros((12, mesh.size)), fun_jac=jac, bc_jac=bc_jac, tol=tol,
+                         max_nodes=1000000), lambda sol, ts: sol.sol(ts)[:3].T
 
 
-def scipy_run(tol):
-    def bc(ya, yb):
-        return np.concatenate([ya[:3] - x0, ya[3:6] - v0, yb[:3] - xT, yb[3:6] - vT])
+class Beanie:
+    name, scene, columns = "beanie", "beanie", ["psi", "theta", "x", "y"]
 
-    mesh = np.linspace(0, T, 11)
-    guess = np.zeros((12, mesh.size))
-    times, sol = [], None
-    for _ in range(REPS):
-        t0 = time.perf_counter()
-        sol = solve_bvp(lambda t, y: A @ y, bc, mesh, guess, tol=tol, max_nodes=100000)
-        times.append(time.perf_counter() - t0)
-    err = np.max(np.abs(sol.sol(check_t)[:3].T - check_x))
-    return sol.status == 0, err, statistics.median(times), sol.x.size
+    def __init__(self):
+        s = load(self.scene)
+        p, bd = s["parameters"], s["boundary"]
+        self.m, I1, I2 = p["m"], p["I1"], p["I2"]
+        self.amp = p["potential"]["amplitude"] if p["potential"]["type"] == "cosine" else 0.0
+        self.c, self.mu = I2 / (I1 + I2), I1 * I2 / (I1 + I2)
+        self.T = s["horizon"]["T"]
+        a, b = bd["initial"], bd["final"]
+        self.psi0, self.dpsi0, self.psiT, self.dpsiT = a["psi"], a["psi_dot"], b["psi"], b["psi_dot"]
+        self.theta0, self.r0, self.Om12 = a["theta"], np.array([a["x"], a["y"]]), np.array([a["Omega1"], a["Omega2"]])
+        self.Omega3 = (b["theta"] - self.theta0 + self.c * (self.psiT - self.psi0)) / self.T
+        # Reference: shooting on (u(0), u'(0)) with DOP853.
+        def end(s):
+            sol = solve_ivp(self.rhs, (0, self.T), [self.psi0, self.dpsi0, s[0], s[1]], method="DOP853", rtol=1e-13,
+                            atol=1e-15)
+            return [sol.y[0, -1] - self.psiT, sol.y[1, -1] - self.dpsiT]
+        self.s0 = fsolve(end, [0.0, 0.0], xtol=1e-14)
+        self.ref = solve_ivp(self.rhs, (0, self.T), [self.psi0, self.dpsi0, *self.s0], method="DOP853", rtol=1e-13,
+                             atol=1e-15, dense_output=True)
+
+    def rhs(self, t, y):  # y = (psi, psi', u, u'); vectorized over columns
+        psi, dpsi, u, du = y
+        return np.array([dpsi, (u - self.amp * np.sin(psi)) / self.mu, du, -self.amp * np.cos(psi) * u / self.mu])
+
+    def group(self, ts, psi):  # theta, x, y of the free beanie on psi(t)
+        theta = self.theta0 + self.Omega3 * ts - self.c * (psi - self.psi0)
+        R = np.array([[np.cos(self.theta0), -np.sin(self.theta0)], [np.sin(self.theta0), np.cos(self.theta0)]])
+        xy = self.r0[None, :] + ts[:, None] * (R @ self.Om12)[None, :]
+        return np.column_stack([psi, theta, xy])
+
+    def exact(self, ts):
+        return self.group(np.asarray(ts), self.ref.sol(ts)[0])
+
+    def scipy(self, tol):
+        mu, A = self.mu, self.amp
+
+        def jac(t, y):
+            psi, dpsi, u, du = y
+            J = np.zeros((4, 4, y.shape[1]))
+            J[0, 1] = 1
+            J[1, 0], J[1, 2] = -A * np.cos(psi) / mu, 1 / mu
+            J[2, 3] = 1
+            J[3, 0], J[3, 2] = A * np.sin(psi) * u / mu, -A * np.cos(psi) / mu
+            return J
+        bc = lambda ya, yb: np.array([ya[0] - self.psi0, ya[1] - self.dpsi0, yb[0] - self.psiT, yb[1] - self.dpsiT])
+        E = np.eye(4)[:2]
+        bc_jac = lambda ya, yb: (np.vstack([E, np.zeros((2, 4))]), np.vstack([np.zeros((2, 4)), E]))
+        mesh = np.linspace(0, self.T, 11)
+        guess = np.zeros((4, mesh.size))
+        guess[0] = self.psi0 + (self.psiT - self.psi0) * mesh / self.T
+        return solve_bvp(self.rhs, bc, mesh, guess, fun_jac=jac, bc_jac=bc_jac, tol=tol, max_nodes=1000000), \
+            lambda sol, ts: self.group(ts, sol.sol(ts)[0])
 
 
-def lpshoot_sweep(grids):
-    runs = {}
-    with tempfile.TemporaryDirectory() as out:
+def scipy_rows(prob):
+    ts = np.linspace(0, prob.T, 401)
+    ref = prob.exact(ts)
+    rows = []
+    for tol in [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10]:
+        times = []
         for _ in range(REPS):
-            subprocess.run([LPSHOOT, "sweep", SCENE, "--N", ",".join(map(str, grids)), "--set", "solver.segments=auto",
-                            "--no-plot", "--quiet", "--out", out], check=True, capture_output=True)
-            with open(os.path.join(out, "sweep.json")) as f:
-                for r in json.load(f)["runs"]:
-                    runs.setdefault(r["N"], []).append(r)
-        # Cross-check one lpshoot trajectory against this script's oracle.
-        subprocess.run([LPSHOOT, "solve", SCENE, "--set", "horizon.N=200", "--set", "solver.segments=8", "--no-plot",
-                        "--quiet", "--out", out], check=True, capture_output=True)
-        data = np.genfromtxt(os.path.join(out, "trajectory.csv"), delimiter=",", names=True)
-        cross = np.max(np.abs(np.stack([data["x1"], data["x2"], data["x3"]], 1) - exact_x(data["t"])))
-    rows = []
-    for N, rs in sorted(runs.items()):
-        rows.append((N, all(r["converged"] for r in rs), rs[0]["error"], statistics.median(r["wall_time_s"] for r in rs)))
-    return rows, cross
-
-
-def lpshoot_richardson(grids):
-    """lpshoot solve with scheme.error_estimate: the extrapolated trajectory (N, N/2, N/4 solves);
-    time = the run's wall time plus the estimate's, error against this script's oracle."""
-    rows = []
-    with tempfile.TemporaryDirectory() as out:
-        for N in grids:
-            times, err = [], None
-            for _ in range(REPS):
-                subprocess.run([LPSHOOT, "solve", SCENE, "--set", f"horizon.N={N}", "--set", "solver.segments=auto",
-                                "--set", "scheme.error_estimate=true", "--no-plot", "--quiet", "--out", out],
-                               check=True, capture_output=True)
-                with open(os.path.join(out, "report.json")) as f:
-                    r = json.load(f)
-                times.append(r["wall_time_s"] + r["error_estimate"]["wall_time_s"])
-                data = np.genfromtxt(os.path.join(out, "trajectory_extrapolated.csv"), delimiter=",", names=True)
-                err = np.max(np.abs(np.stack([data["x1"], data["x2"], data["x3"]], 1) - exact_x(data["t"])))
-            rows.append((N, err, statistics.median(times)))
+            t0 = time.perf_counter()
+            sol, at = prob.scipy(tol)
+            times.append(time.perf_counter() - t0)
+        err = float(np.max(np.abs(at(sol, ts) - ref)))
+        rows.append((f"tol {tol:g} ({sol.x.size} nodes)", sol.status == 0, err, statistics.median(times)))
     return rows
 
 
+def lpshoot_rows(prob, scheme):
+    obj, grids = SCHEMES[scheme]
+    rows = []
+    with tempfile.TemporaryDirectory() as out:
+        for N in grids:
+            times, ok, err = [], True, None
+            for _ in range(REPS):
+                subprocess.run([LPSHOOT, "solve", os.path.join(SCENES, prob.scene + ".json"), "--set", f"horizon.N={N}",
+                                "--set", "solver.segments=auto", "--set", "scheme=" + json.dumps(obj), "--no-plot",
+                                "--quiet", "--out", out], check=False, capture_output=True)
+                with open(os.path.join(out, "report.json")) as f:
+                    r = json.load(f)
+                ok = ok and r["converged"]
+                times.append(r["wall_time_s"])
+            if ok:
+                data = np.genfromtxt(os.path.join(out, "trajectory.csv"), delimiter=",", names=True)
+                got = np.column_stack([data[c] for c in prob.columns])
+                err = float(np.max(np.abs(got - prob.exact(data["t"]))))
+            rows.append((f"N = {N}", ok, err, statistics.median(times)))
+    return rows
+
+
+def time_for(points, level):
+    """Time to reach an error level, log-log interpolation along a curve of (error, time)."""
+    pts = sorted((e, t) for e, t in points if e and e > 0)
+    for (e1, t1), (e2, t2) in zip(pts, pts[1:]):
+        if e1 <= level <= e2:
+            w = np.log(level / e1) / np.log(e2 / e1)
+            return float(np.exp(np.log(t1) + w * (np.log(t2) - np.log(t1))))
+    return None
+
+
 def main():
-    print(f"electron scene {os.path.relpath(SCENE)}, T = {T}; median of {REPS} runs; error = max |x - x_exact|\n")
-    sc = [(tol,) + scipy_run(tol) for tol in [1e-3, 1e-4, 1e-5, 1e-6, 1e-8]]
-    ls, cross = lpshoot_sweep([25, 50, 100, 200, 400, 800, 1600])
-    print("| solver | setting | converged | error | time [ms] |")
-    print("|---|---|---|---|---|")
-    for tol, ok, err, t, nodes in sc:
-        print(f"| scipy solve_bvp | tol {tol:g} ({nodes} nodes) | {ok} | {err:.2e} | {1e3 * t:.2f} |")
-    for N, ok, err, t in ls:
-        print(f"| lpshoot (multiple, 2nd-order closure) | N = {N} | {ok} | {err:.2e} | {1e3 * t:.2f} |")
-    rich = lpshoot_richardson([100, 200, 400, 800])
-    for N, err, t in rich:
-        print(f"| lpshoot + Richardson (error_estimate) | N = {N} (and N/2, N/4) | True | {err:.2e} | {1e3 * t:.2f} |")
-    print(f"\ncross-check: lpshoot N = 200 against this script's expm oracle: {cross:.2e}")
-
-    # Time to reach an error level (log-log interpolation along each method's curve).
-    def time_for(points, level):
-        pts = sorted((e, t) for e, t in points if e and e > 0)
-        for (e1, t1), (e2, t2) in zip(pts, pts[1:]):
-            if e1 <= level <= e2:
-                w = np.log(level / e1) / np.log(e2 / e1)
-                return float(np.exp(np.log(t1) + w * (np.log(t2) - np.log(t1))))
-        return None
-
-    sp = [(err, t) for _, ok, err, t, _ in sc if ok]
-    lp = [(err, t) for _, ok, err, t in ls if ok]
-    lr = [(err, t) for _, err, t in rich]
-    fmt = lambda x: f"{x * 1e3:.2f}" if x else "-"
-    ratio = lambda b, a: f"{b / a:.2f}" if a and b else "n/a"
-    print("\n| error level | scipy solve_bvp [ms] | lpshoot [ms] | lpshoot + Richardson [ms] | lpshoot / scipy | Richardson / scipy |")
-    print("|---|---|---|---|---|---|")
-    for level in [1e-4, 1e-5, 1e-6, 1e-7]:
-        a, b, c = time_for(sp, level), time_for(lp, level), time_for(lr, level)
-        print(f"| {level:g} | {fmt(a)} | {fmt(b)} | {fmt(c)} | {ratio(b, a)} | {ratio(c, a)} |")
-    print("(times interpolated log-log along each curve; '-': the level is outside that curve)")
+    for prob in [Electron(), Beanie()]:
+        print(f"\n### {prob.name} (examples/scenes/{prob.scene}.json, T = {prob.T}); median of {REPS} runs\n")
+        curves = {"scipy solve_bvp": scipy_rows(prob)}
+        for s in SCHEMES:
+            curves["lpshoot " + s] = lpshoot_rows(prob, s)
+        print("| solver | setting | converged | error | time [ms] |")
+        print("|---|---|---|---|---|")
+        for name, rows in curves.items():
+            for setting, ok, err, t in rows:
+                e = f"{err:.2e}" if err is not None else "-"
+                print(f"| {name} | {setting} | {ok} | {e} | {1e3 * t:.2f} |")
+        ref = {lv: time_for([(e, t) for _, ok, e, t in curves["scipy solve_bvp"] if ok], lv) for lv in LEVELS}
+        print("\n| error level | " + " | ".join(f"{n} [ms]" for n in curves) + " | " +
+              " | ".join(f"{n} / scipy" for n in list(curves)[1:]) + " |")
+        print("|---" * (2 * len(curves)) + "|")
+        for lv in LEVELS:
+            ts = [time_for([(e, t) for _, ok, e, t in rows if ok], lv) for rows in curves.values()]
+            cells = [f"{1e3 * t:.2f}" if t else "-" for t in ts]
+            ratios = [f"{t / ref[lv]:.2f}" if t and ref[lv] else "n/a" for t in ts[1:]]
+            print(f"| {lv:g} | " + " | ".join(cells) + " | " + " | ".join(ratios) + " |")
+        print("(times interpolated log-log along each curve; '-': the level is outside that curve)")
 
 
 if __name__ == "__main__":

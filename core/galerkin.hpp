@@ -142,23 +142,38 @@ Jet<typename Sch::Model, T> jet_at(const typename Sch::Model& model, const Inter
   return q;
 }
 
-// L~ of one interval: h Σ_i b_i [ℓ(q_i) + λ_i · χ(q_i)].
+// The two parts of L~ = L0 + λ · C on one interval: L0 = h Σ_i b_i ℓ(q_i) and the constraint
+// terms C_{i,c} = h b_i χ_c(q_i) (multiplier layout). L~ is linear in the multipliers, which the
+// step's derivatives exploit (galerkin_step.hpp).
+template <class Sch>
+constexpr int multiplier_count = Sch::gauss * Sch::m;
+
 template <class Sch, class T>
-T interval_action(const typename Sch::Model& model, const Interval<Sch, T>& iv, double h) {
+void interval_parts(const typename Sch::Model& model, const Interval<Sch, T>& iv, double h, T& L0,
+                    Vec<T, multiplier_count<Sch>>& C) {
   constexpr int m = Sch::m;
   const auto& tab = GalerkinTable<Sch::degree, Sch::gauss>::get();
   GroupCurveEnds<Sch, T> ends;
   if constexpr (Sch::d > 0) ends = group_curve_ends(model, iv, h);
-  T L(0.0);
+  L0 = T(0.0);
   for (int i = 0; i < Sch::gauss; ++i) {
     const auto q = jet_at(model, iv, ends, i, h);
-    T li = model.template lagrangian<T>(q);
+    L0 = L0 + (h * tab.b[i]) * model.template lagrangian<T>(q);
     if constexpr (m > 0) {
       const Vec<T, m> chi = model.template constraints<T>(q);
-      for (int c = 0; c < m; ++c) li = li + iv.w(Sch::multipliers(i) + c) * chi(c);
+      for (int c = 0; c < m; ++c) C(i * m + c) = (h * tab.b[i]) * chi(c);
     }
-    L = L + (h * tab.b[i]) * li;
   }
+}
+
+// L~ of one interval: h Σ_i b_i [ℓ(q_i) + λ_i · χ(q_i)].
+template <class Sch, class T>
+T interval_action(const typename Sch::Model& model, const Interval<Sch, T>& iv, double h) {
+  constexpr int nm = multiplier_count<Sch>;
+  T L;
+  Vec<T, nm> C;
+  interval_parts(model, iv, h, L, C);
+  for (int k = 0; k < nm; ++k) L = L + iv.w(Sch::multipliers(0) + k) * C(k);
   return L;
 }
 
@@ -179,12 +194,11 @@ double interval_cost(const typename Sch::Model& model, const Interval<Sch, doubl
 // (interval n): left's increments take the perturbation, right's base takes it and right's
 // increments compensate (its end node stays). Either may be null at a boundary: the result is
 // then the natural boundary condition of that end.
-template <class Sch, class TO>
-Vec<TO, Sch::variation> node_residual(const typename Sch::Model& model, const Interval<Sch, TO>* left,
-                                      const Interval<Sch, TO>* right, double h) {
+template <class Sch, class TO, class TI>
+void perturb_node(const Interval<Sch, TO>* left, const Interval<Sch, TO>* right, double h, Interval<Sch, TI>& l,
+                  Interval<Sch, TI>& q) {
   using G = typename Sch::Group;
-  constexpr int r = Sch::r, d = Sch::d, nv = Sch::variation;
-  using TI = Dual<TO, nv>;
+  constexpr int r = Sch::r, d = Sch::d;
   Vec<TI, r> ex, ev;
   Vec<TI, d> eO;
   typename G::template Tangent<TI> eta;
@@ -196,9 +210,8 @@ Vec<TO, Sch::variation> node_residual(const typename Sch::Model& model, const In
     eO(a) = TI::variable(TO(0.0), 2 * r + a);
     eta(a) = TI::variable(TO(0.0), 2 * r + d + a);
   }
-  TI S(0.0);
   if (left) {
-    Interval<Sch, TI> l = left->template cast<TI>();
+    l = left->template cast<TI>();
     l.X2 += ex;
     l.V1 += ev;
     if constexpr (d > 0) {
@@ -206,10 +219,9 @@ Vec<TO, Sch::variation> node_residual(const typename Sch::Model& model, const In
       const typename G::template Tangent<TI> step = h * eta;
       l.W = G::compose(l.W, G::template exp<TI>(step));
     }
-    S = S + interval_action(model, l, h);
   }
   if (right) {
-    Interval<Sch, TI> q = right->template cast<TI>();
+    q = right->template cast<TI>();
     q.x += (h * h) * ex;
     q.v += h * ev;
     q.X2 -= ex + ev;
@@ -220,30 +232,83 @@ Vec<TO, Sch::variation> node_residual(const typename Sch::Model& model, const In
       const typename G::template Tangent<TI> step = -h * eta;
       q.W = G::compose(G::template exp<TI>(step), q.W);
     }
-    S = S + interval_action(model, q, h);
   }
+}
+
+template <class Sch, class TO>
+Vec<TO, Sch::variation> node_residual(const typename Sch::Model& model, const Interval<Sch, TO>* left,
+                                      const Interval<Sch, TO>* right, double h) {
+  constexpr int nv = Sch::variation;
+  using TI = Dual<TO, nv>;
+  Interval<Sch, TI> l, q;
+  perturb_node(left, right, h, l, q);
+  TI S(0.0);
+  if (left) S = S + interval_action(model, l, h);
+  if (right) S = S + interval_action(model, q, h);
   Vec<TO, nv> E;
   for (int i = 0; i < nv; ++i) E(i) = S.d[i] / h;
   return E;
+}
+
+// ∂E/∂λ of one interval adjacent to the node (the other null): ∂C_k/∂e / h, nv x (Q m). E is
+// linear in the interval's multipliers, so this is a first derivative only.
+template <class Sch>
+Eigen::Matrix<double, Sch::variation, multiplier_count<Sch>> node_multiplier_jacobian(
+    const typename Sch::Model& model, const Interval<Sch, double>* left, const Interval<Sch, double>* right, double h) {
+  constexpr int nv = Sch::variation, nm = multiplier_count<Sch>;
+  using TI = Dual<double, nv>;
+  Interval<Sch, TI> l, q;
+  perturb_node(left, right, h, l, q);
+  TI L0;
+  Vec<TI, nm> C;
+  interval_parts(model, left ? l : q, h, L0, C);
+  Eigen::Matrix<double, nv, nm> D;
+  for (int k = 0; k < nm; ++k)
+    for (int i = 0; i < nv; ++i) D(i, k) = C(k).d[i] / h;
+  return D;
 }
 
 // The interval's own equations: ∂L~/∂(bubbles, multipliers), divided by h (the multiplier rows
 // are b_i χ(q_i)).
 template <class Sch, class TO>
 Vec<TO, Sch::aux> aux_residual(const typename Sch::Model& model, const Interval<Sch, TO>& iv, double h) {
-  constexpr int na = Sch::aux;
-  if constexpr (na == 0) {
-    (void)model, (void)iv, (void)h;
-    return Vec<TO, 0>();
-  } else {
-    using TI = Dual<TO, na>;
+  constexpr int na = Sch::aux, nm = multiplier_count<Sch>, nb = na - nm;
+  Vec<TO, na> R;
+  if constexpr (nb > 0) {  // bubbles: ∂L~/∂a / h
+    using TI = Dual<TO, nb>;
     Interval<Sch, TI> q = iv.template cast<TI>();
-    for (int a = 0; a < na; ++a) q.w(a) = TI::variable(iv.w(a), a);
+    for (int a = 0; a < nb; ++a) q.w(a) = TI::variable(iv.w(a), a);
     const TI S = interval_action(model, q, h);
-    Vec<TO, na> R;
-    for (int i = 0; i < na; ++i) R(i) = S.d[i] / h;
-    return R;
+    for (int i = 0; i < nb; ++i) R(i) = S.d[i] / h;
   }
+  if constexpr (nm > 0) {  // multipliers: ∂L~/∂λ / h = C / h = b_i χ(q_i)
+    TO L0;
+    Vec<TO, nm> C;
+    interval_parts(model, iv, h, L0, C);
+    R.template tail<nm>() = C / h;
+  }
+  (void)model, (void)iv, (void)h;
+  return R;
+}
+
+// ∂(bubble rows)/∂λ: ∂C_k/∂a / h, (na - Q m) x (Q m), first derivatives only.
+template <class Sch>
+Eigen::Matrix<double, Sch::aux - multiplier_count<Sch>, multiplier_count<Sch>> bubble_multiplier_jacobian(
+    const typename Sch::Model& model, const Interval<Sch, double>& iv, double h) {
+  constexpr int nm = multiplier_count<Sch>, nb = Sch::aux - nm;
+  Eigen::Matrix<double, nb, nm> D;
+  if constexpr (nb > 0 && nm > 0) {
+    using TI = Dual<double, nb>;
+    Interval<Sch, TI> q = iv.template cast<TI>();
+    for (int a = 0; a < nb; ++a) q.w(a) = TI::variable(iv.w(a), a);
+    TI L0;
+    Vec<TI, nm> C;
+    interval_parts(model, q, h, L0, C);
+    for (int k = 0; k < nm; ++k)
+      for (int i = 0; i < nb; ++i) D(i, k) = C(k).d[i] / h;
+  }
+  (void)model, (void)iv, (void)h;
+  return D;
 }
 
 // The node after an interval: (x, v, Ω) at its end, and the interval that starts there with

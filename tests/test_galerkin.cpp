@@ -179,13 +179,14 @@ namespace {
 using BG = BeanieGalerkin<3>;
 
 // A beanie Galerkin interval with non-zero multipliers (from the guess of a well-posed problem).
-Interval<BG, double> beanie_interval_with_multipliers(const BeanieModel& model, double T, int N) {
+template <int S = 3>
+Interval<BeanieGalerkin<S>, double> beanie_interval_with_multipliers(const BeanieModel& model, double T, int N) {
   BeanieBoundary s, e;
   s.psi = 0.2, s.psi_dot = 0.4, s.theta = 0.1, s.x = 0, s.y = 0, s.Omega1 = 0.5, s.Omega2 = 0.2;
   e.psi = 1, e.psi_dot = 0, e.theta = 1;
-  const auto bvp = beanie_galerkin_bvp<3>(model, T, N, s, e);
-  Interval<BG, double> iv = beanie_galerkin_guess<3>(bvp, s, e).trajectory.intervals[0];
-  for (int i = 0; i < BG::aux; ++i) iv.w(i) = 0.01 * std::sin(1.0 + i);
+  const auto bvp = beanie_galerkin_bvp<S>(model, T, N, s, e);
+  Interval<BeanieGalerkin<S>, double> iv = beanie_galerkin_guess<S>(bvp, s, e).trajectory.intervals[0];
+  for (int i = 0; i < BeanieGalerkin<S>::aux; ++i) iv.w(i) = 0.01 * std::sin(1.0 + i);  // bubbles and multipliers
   return iv;
 }
 }  // namespace
@@ -214,11 +215,15 @@ TEST(GalerkinBeanie, MomentumIsConservedToRoundoffWithNonZeroMultipliers) {
   EXPECT_LT(relative, 1e-12);
 }
 
-TEST(GalerkinFlow, SensitivityMatchesFiniteDifferences) {
+// The flow's sensitivities (implicit function theorem on the step, multiplier columns as first
+// derivatives of the constraint terms, galerkin_step.hpp) against central differences.
+template <int S>
+void check_flow_sensitivity() {
+  using BG = BeanieGalerkin<S>;
   BeanieModel model;
   model.par = {1.0, 1.0, 0.5, 1.0};
   const double h = 0.05;
-  const auto start = beanie_interval_with_multipliers(model, 2.0, 40);
+  const auto start = beanie_interval_with_multipliers<S>(model, 2.0, 40);
   const SE2::Element<double> g0{0.3, Eigen::Vector2d(0.5, -0.2)};
   NewtonOptions tight;
   tight.step_tolerance = 1e-13;
@@ -235,21 +240,24 @@ TEST(GalerkinFlow, SensitivityMatchesFiniteDifferences) {
     auto end_after = [&](double s) {
       Vec<double, n> delta = Vec<double, n>::Zero();
       delta(j) = s;
-      const auto iv = retract(start, Vec<double, ns>(delta.head<ns>()), h);
-      const SE2::Element<double> g = SE2::compose(g0, SE2::exp<double>(Eigen::Vector3d(delta.tail<3>())));
+      const auto iv = retract<BG>(start, Vec<double, ns>(delta.template head<ns>()), h);
+      const SE2::Element<double> g = SE2::compose(g0, SE2::exp<double>(Eigen::Vector3d(delta.template tail<3>())));
       const auto r = flow.run(iv, steps, nullptr, g);
       EXPECT_TRUE(r.report.ok());
       Eigen::VectorXd out(n);
-      out.head<ns>() = state_difference(r.trajectory.intervals.back(), base.trajectory.intervals.back(), h);
-      out.tail<3>() = SE2::log(SE2::compose(SE2::inverse(base.g_last), r.g_last));
+      out.head(ns) = state_difference(r.trajectory.intervals.back(), base.trajectory.intervals.back(), h);
+      out.tail(3) = SE2::log(SE2::compose(SE2::inverse(base.g_last), r.g_last));
       return out;
     };
     const Eigen::VectorXd fd = (end_after(eps) - end_after(-eps)) / (2 * eps);
-    worst = std::max(worst, (base.sensitivity.col(j) - fd).lpNorm<Eigen::Infinity>() / std::max(1.0, fd.lpNorm<Eigen::Infinity>()));
+    worst = std::max(worst, (base.sensitivity.col(j) - fd).template lpNorm<Eigen::Infinity>() / std::max(1.0, fd.template lpNorm<Eigen::Infinity>()));
   }
-  std::printf("beanie Galerkin flow, %d steps: max relative sensitivity error %.2e\n", steps, worst);
+  std::printf("beanie Galerkin flow (degree %d), %d steps: max relative sensitivity error %.2e\n", S, steps, worst);
   EXPECT_LT(worst, 1e-6);
 }
+
+TEST(GalerkinFlow, SensitivityMatchesFiniteDifferences) { check_flow_sensitivity<3>(); }
+TEST(GalerkinFlow, SensitivityWithBubblesMatchesFiniteDifferences) { check_flow_sensitivity<4>(); }
 
 TEST(GalerkinFlow, TooFewGaussPointsMakeTheStepSingular) {
   // A cubic with one Gauss point (and a quartic with two) cannot see every direction of the
