@@ -68,51 +68,130 @@ void galerkin_step_block(const Interval<Sch, double>& state, const Interval<Sch,
   for (int a = 0; a < na; ++a) right.w(a) = var(z.w(a), 2 * r + 2 * d + a, zl, 0);
 }
 
+// The state interval with its smooth tangent coordinates (all but the multipliers, the last
+// Q m) seeded in columns first .. first + state - Q m - 1 of T.
+template <class Sch, class T>
+Interval<Sch, T> seeded_state(const Interval<Sch, double>& state, double h, int first) {
+  using G = typename Sch::Group;
+  constexpr int r = Sch::r, d = Sch::d, nb = Sch::aux - multiplier_count<Sch>;
+  Interval<Sch, T> s = state.template cast<T>();
+  for (int a = 0; a < r; ++a) {
+    s.x(a) = T::variable(state.x(a), first + Sch::x_off + a);
+    s.v(a) = T::variable(state.v(a), first + Sch::v_off + a);
+    s.X2(a) = T::variable(state.X2(a), first + Sch::X2_off + a);
+    s.V1(a) = T::variable(state.V1(a), first + Sch::V1_off + a);
+  }
+  for (int a = 0; a < d; ++a) {
+    s.Om(a) = T::variable(state.Om(a), first + Sch::Om_off + a);
+    s.O1(a) = T::variable(state.O1(a), first + Sch::O1_off + a);
+  }
+  if constexpr (d > 0) {
+    typename G::template Tangent<T> delta;
+    for (int a = 0; a < d; ++a) delta(a) = T::variable(0.0, first + Sch::W_off + a) * h;  // W exp(h δ)
+    s.W = G::compose(s.W, G::template exp<T>(delta));
+  }
+  for (int a = 0; a < nb; ++a) s.w(a) = T::variable(state.w(a), first + Sch::aux_off + a);
+  return s;
+}
+
 // F = (E_n, interval n's equations) at z and its derivatives: columns are the unknowns, then (if
 // NO = unknowns + state) the state's tangent coordinates. Given `fixed` (interval n-1's part of
 // E_n, which does not depend on z) only interval n is differentiated.
 //
-// L~ = L0 + λ · C is linear in the multipliers (galerkin.hpp), and they are the last Q m unknowns
-// and state coordinates. Second derivatives are taken by nested duals over the other ("smooth")
-// directions only; the multiplier columns are first derivatives of C (∂E/∂λ = ∂C/∂e / h, the
-// multiplier rows C/h do not depend on λ). This cuts the nested width from unknowns + state to
-// their smooth parts (beanie, cubic: 33 to 21).
+// Derivatives are taken only in the directions each part depends on (nested duals are costly in
+// the product of their widths):
+// - L~ = L0 + λ · C is linear in the multipliers (galerkin.hpp), the last Q m unknowns and state
+//   coordinates: second derivatives by nested duals over the other ("smooth") directions only;
+//   the multiplier columns are first derivatives of C (∂E/∂λ = ∂C/∂e / h; the multiplier rows
+//   C/h do not depend on λ).
+// - Interval n depends on the state only through its base node (x, v, Ω at the end of interval
+//   n-1, linear in the state): it is differentiated in its smooth unknowns and its base node, and
+//   the base columns are mapped to the state's by that linear map.
+// - Interval n-1 (the state) enters E_n only: differentiated in its own smooth coordinates.
 template <class Sch, int NO>
 void evaluate_galerkin_step(const typename Sch::Model& model, double h, const Interval<Sch, double>& state,
                             const Interval<Sch, double>& z, bool with_state, const Vec<double, Sch::variation>* fixed,
                             Vec<double, Sch::unknowns>& F, Eigen::Matrix<double, Sch::unknowns, NO>& J) {
-  constexpr int nv = Sch::variation, na = Sch::aux, nz = Sch::unknowns, ns = Sch::state;
-  constexpr int nm = multiplier_count<Sch>, nzs = nz - nm, nss = ns - nm, nb = na - nm;
+  using G = typename Sch::Group;
+  constexpr int r = Sch::r, d = Sch::d, nv = Sch::variation, na = Sch::aux, nz = Sch::unknowns, ns = Sch::state;
+  constexpr int node = Sch::node, nm = multiplier_count<Sch>, nzs = nz - nm, nss = ns - nm, nb = na - nm;
   static_assert(NO == nz || NO == nz + ns, "columns: the unknowns, or the unknowns and the state");
   constexpr bool state_cols = NO == nz + ns;
-  constexpr int NS = state_cols ? nzs + nss : nzs;  // seeded (smooth) columns
-  using T = Dual<double, NS>;
-  Interval<Sch, T> left, right;
-  galerkin_step_block(state, z, with_state && state_cols, h, left, right, nzs, nzs, nss);
-  const Vec<T, nv> E = node_residual<Sch, T>(model, fixed ? nullptr : &left, &right, h);
-  const Vec<T, na> A = aux_residual<Sch, T>(model, right, h);
-  // Smooth columns back to their places: z's in 0..nzs-1, the state's in nz..nz+nss-1.
-  auto put = [&](int row, const T& f) {
-    for (int c = 0; c < nzs; ++c) J(row, c) = f.d[c];
-    if constexpr (state_cols)
-      for (int c = 0; c < nss; ++c) J(row, nz + c) = f.d[nzs + c];
-  };
+  const bool left_seeded = state_cols && with_state && !fixed;
+
+  // Interval n: smooth unknowns in columns 0..nzs-1, its base node (x, v, Ω) in nzs..nzs+node-1.
+  constexpr int NR = state_cols ? nzs + node : nzs;
+  using TR = Dual<double, NR>;
+  Interval<Sch, TR> right = z.template cast<TR>();
+  const Interval<Sch, double> base = next_interval_base(state, h);
+  right.x = base.x.template cast<TR>(), right.v = base.v.template cast<TR>(), right.Om = base.Om.template cast<TR>();
+  for (int a = 0; a < r; ++a) {
+    right.X2(a) = TR::variable(z.X2(a), a);
+    right.V1(a) = TR::variable(z.V1(a), r + a);
+    if constexpr (state_cols) {
+      right.x(a) = TR::variable(base.x(a), nzs + a);
+      right.v(a) = TR::variable(base.v(a), nzs + r + a);
+    }
+  }
+  for (int a = 0; a < d; ++a) {
+    right.O1(a) = TR::variable(z.O1(a), 2 * r + a);
+    if constexpr (state_cols) right.Om(a) = TR::variable(base.Om(a), nzs + 2 * r + a);
+  }
+  if constexpr (d > 0) {
+    typename G::template Tangent<TR> zeta;
+    for (int a = 0; a < d; ++a) zeta(a) = TR::variable(0.0, 2 * r + d + a) * h;  // Ŵ exp(h ζ)
+    right.W = G::compose(right.W, G::template exp<TR>(zeta));
+  }
+  for (int a = 0; a < nb; ++a) right.w(a) = TR::variable(z.w(a), 2 * r + 2 * d + a);
+  const Vec<TR, nv> E = node_residual<Sch, TR>(model, nullptr, &right, h);
+  const Vec<TR, na> A = aux_residual<Sch, TR>(model, right, h);
+
   J.setZero();
-  for (int i = 0; i < nv; ++i) {
-    F(i) = E(i).v + (fixed ? (*fixed)(i) : 0.0);
-    put(i, E(i));
+  Eigen::Matrix<double, nz, node> Jbase;
+  for (int i = 0; i < nz; ++i) {
+    const TR& f = i < nv ? E(i) : A(i - nv);
+    F(i) = f.v;
+    for (int c = 0; c < nzs; ++c) J(i, c) = f.d[c];
+    if constexpr (state_cols)
+      for (int c = 0; c < node; ++c) Jbase(i, c) = f.d[nzs + c];
   }
-  for (int i = 0; i < na; ++i) {
-    F(nv + i) = A(i).v;
-    put(nv + i, A(i));
+  if constexpr (state_cols) {  // base = (x + h v + h² X2, v + h V1, Ω + h O1) of the state
+    for (int a = 0; a < r; ++a) {
+      J.col(nz + Sch::x_off + a) += Jbase.col(a);
+      J.col(nz + Sch::v_off + a) += h * Jbase.col(a) + Jbase.col(r + a);
+      J.col(nz + Sch::X2_off + a) += (h * h) * Jbase.col(a);
+      J.col(nz + Sch::V1_off + a) += h * Jbase.col(r + a);
+    }
+    for (int a = 0; a < d; ++a) {
+      J.col(nz + Sch::Om_off + a) += Jbase.col(2 * r + a);
+      J.col(nz + Sch::O1_off + a) += h * Jbase.col(2 * r + a);
+    }
   }
+
+  // Interval n-1's part of E_n.
+  if (fixed) {
+    F.template head<nv>() += *fixed;
+  } else if (left_seeded) {
+    if constexpr (state_cols) {
+      using TL = Dual<double, nss>;
+      const Interval<Sch, TL> left = seeded_state<Sch, TL>(state, h, 0);
+      const Vec<TL, nv> El = node_residual<Sch, TL>(model, &left, nullptr, h);
+      for (int i = 0; i < nv; ++i) {
+        F(i) += El(i).v;
+        for (int c = 0; c < nss; ++c) J(i, nz + c) += El(i).d[c];
+      }
+    }
+  } else {
+    F.template head<nv>() += node_residual<Sch, double>(model, &state, nullptr, h);
+  }
+
   if constexpr (nm > 0) {
-    Interval<Sch, double> l, rd;
-    galerkin_step_block(state, z, false, h, l, rd);
+    Interval<Sch, double> rd = z;
+    rd.x = base.x, rd.v = base.v, rd.Om = base.Om;
     J.template block<nv, nm>(0, nzs) = node_multiplier_jacobian<Sch>(model, nullptr, &rd, h);
     if constexpr (nb > 0) J.template block<nb, nm>(nv, nzs) = bubble_multiplier_jacobian<Sch>(model, rd, h);
     if constexpr (state_cols)
-      if (with_state && !fixed) J.template block<nv, nm>(0, nz + nss) = node_multiplier_jacobian<Sch>(model, &state, nullptr, h);
+      if (left_seeded) J.template block<nv, nm>(0, nz + nss) = node_multiplier_jacobian<Sch>(model, &state, nullptr, h);
   }
 }
 
