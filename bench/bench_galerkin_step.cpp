@@ -1,0 +1,73 @@
+// One Galerkin flow step (METHOD.md §9), derived by automatic differentiation: the step's Newton
+// solve and its sensitivity (implicit function theorem), beanie and electron, orders 4 and 6.
+//   ./build/bench/bench_galerkin_step --benchmark_repetitions=7 --benchmark_report_aggregates_only=true
+#include <lpshoot/problems/beanie_bvp.hpp>
+#include <lpshoot/problems/electron_bvp.hpp>
+
+#include <benchmark/benchmark.h>
+
+using namespace lpshoot;
+using namespace lpshoot::problems;
+
+namespace {
+
+constexpr double kH = 0.01;
+
+// The first interval of each example's guess, with non-zero bubbles and multipliers.
+template <int S>
+Interval<BeanieGalerkin<S>, double> beanie_start(const BeanieModel& model) {
+  BeanieBoundary s, e;
+  s.psi = 0.2, s.psi_dot = 0.4, s.theta = 0.1, s.x = 0, s.y = 0, s.Omega1 = 0.5, s.Omega2 = 0.2;
+  e.psi = 1, e.psi_dot = 0, e.theta = 1;
+  const auto bvp = beanie_galerkin_bvp<S>(model, 2.0, 200, s, e);
+  auto iv = beanie_galerkin_guess<S>(bvp, s, e).trajectory.intervals[0];
+  for (int i = 0; i < BeanieGalerkin<S>::aux; ++i) iv.w(i) = 0.01 * std::sin(1.0 + i);
+  return iv;
+}
+
+template <int S>
+Interval<ElectronGalerkin<S>, double> electron_start(const ElectronModel& model) {
+  ElectronBoundary a, b;
+  a.position = {1, 0, 0.5}, a.velocity = {0, 1, 0}, b.position = {0, 1, -0.5}, b.velocity = {-1, 0, 0.2};
+  const auto bvp = electron_galerkin_bvp<S>(model, 2.0, 200, a, b);
+  return electron_galerkin_guess<S>(bvp, a, b).trajectory.intervals[0];
+}
+
+template <class Sch>
+void step(benchmark::State& st, const typename Sch::Model& model, const Interval<Sch, double>& start, bool sensitivity) {
+  const NewtonOptions opt;
+  Interval<Sch, double> z;
+  for (auto _ : st) {
+    const StepReport r = solve_galerkin_step<Sch>(model, kH, start, 1, opt, z);
+    benchmark::DoNotOptimize(r.iterations);
+    if (sensitivity) {
+      auto dz = galerkin_step_sensitivity<Sch>(model, kH, start, z);
+      benchmark::DoNotOptimize(dz);
+    }
+  }
+}
+
+BeanieModel beanie() {
+  BeanieModel b;
+  b.par = {1.0, 1.0, 0.5, 1.0};
+  return b;
+}
+
+}  // namespace
+
+template <int S>
+static void BM_BeanieGalerkinStep(benchmark::State& st) {
+  step<BeanieGalerkin<S>>(st, beanie(), beanie_start<S>(beanie()), st.range(0) != 0);
+}
+BENCHMARK_TEMPLATE(BM_BeanieGalerkinStep, 3)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK_TEMPLATE(BM_BeanieGalerkinStep, 4)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+template <int S>
+static void BM_ElectronGalerkinStep(benchmark::State& st) {
+  const ElectronModel m = model_of(Electron{});
+  step<ElectronGalerkin<S>>(st, m, electron_start<S>(m), st.range(0) != 0);
+}
+BENCHMARK_TEMPLATE(BM_ElectronGalerkinStep, 3)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK_TEMPLATE(BM_ElectronGalerkinStep, 4)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+BENCHMARK_MAIN();
