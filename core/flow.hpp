@@ -132,8 +132,8 @@ class DiscreteFlow {
       if (seed) {
         // New state = shifted old state + z; the new rows come from the implicit function theorem.
         const Eigen::Matrix<double, D::unknowns, ns> dz = step_sensitivity(problem_, h_, s, z);
-        const Eigen::MatrixXd dzS = dz * out.sensitivity;
         const Eigen::MatrixXd& S = out.sensitivity;
+        const Eigen::MatrixXd dzS = dz * S.topRows(ns);  // the state's rows (not the group element's)
         next.resize(S.rows(), S.cols());
         using FS = FlowState<P>;
         next.middleRows(FS::p_offset(0), (2 * k - 1) * r) = S.middleRows(FS::p_offset(1), (2 * k - 1) * r);

@@ -12,6 +12,7 @@ packages=(
   libgtest-dev libbenchmark-dev      # GoogleTest, Google Benchmark
   libcli11-dev nlohmann-json3-dev    # the application
   gnuplot-nox                        # plots
+  python3                            # the CLI fuzz test (standard library only)
 )
 
 missing=()

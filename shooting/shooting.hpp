@@ -9,6 +9,7 @@
 #include "shooting_system.hpp"
 
 #include <chrono>
+#include <cmath>
 
 namespace lpshoot {
 
@@ -39,7 +40,8 @@ template <class X>
 struct ShootingResult {
   using A = SchemeFor<X>;
   ShootingStatus status = ShootingStatus::NotConverged;
-  std::string message;
+  std::string message;  // one sentence: what failed, why, and the one thing to try
+  std::string detail;   // the solver's own account (flags, phases), the other attempt's outcome
   int iterations = 0;
   std::vector<double> residual_history;
   double residual_norm = 0;
@@ -133,13 +135,18 @@ ShootingResult<X> solve_from_starts(const typename SchemeFor<X>::BVP& bvp,
     out.dependent_conditions = std::move(diag.dependent_conditions);
     out.singular_values = std::move(diag.singular_values);
   }
-  const std::string solver_msg = so.message.empty() ? std::string("the solver did not converge") : so.message + " x tolerance";
+  // The backend's account ("KINSOL stopped with ... , residual 24.2"): residuals of scaled rows.
+  const bool names_residual = so.message.find(", residual ") != std::string::npos;
+  out.detail = so.message.empty() ? std::string() : so.message + (names_residual ? " x tolerance" : "");
   // A solver that ran away from the guess leaves a Jacobian whose rank says nothing about the data.
   const bool diverged = so.status != SolverStatus::Converged && !so.residual_history.empty() &&
                         !(out.residual_norm <= so.residual_history.front());
   // Nor does one where the flow has blown up (conditions off by more than 1e3 in their own units,
   // e.g. a stiff potential from a poor guess): that is a failure to converge, whatever the rank.
   const bool far = so.status != SolverStatus::Converged && !(out.raw_residual_norm <= 1e3);
+  const std::string rank_note = out.rank < out.unknowns ? " (the Jacobian there has rank " + std::to_string(out.rank) +
+                                                              " of " + std::to_string(out.unknowns) + ")"
+                                                        : std::string();
   if (out.rank < out.unknowns && !diverged && !far) {
     std::string msg = "the shooting Jacobian is rank deficient (rank " + std::to_string(out.rank) + " of " +
                       std::to_string(out.unknowns) +
@@ -148,31 +155,29 @@ ShootingResult<X> solve_from_starts(const typename SchemeFor<X>::BVP& bvp,
     for (size_t i = 0; i < out.dependent_conditions.size() && i < 3; ++i) msg += (i ? "; " : "") + out.dependent_conditions[i];
     if (out.dependent_conditions.size() > 3)
       msg += "; and " + std::to_string(out.dependent_conditions.size() - 3) + " more";
-    if (so.status != SolverStatus::Converged) msg += " (" + solver_msg + ")";
     return finish(ShootingStatus::RankDeficient, msg);
   }
   if (so.status != SolverStatus::Converged) {
-    std::string msg = solver_msg;
-    if (diverged)
-      msg += "; the residual grew from " + format_residual(so.residual_history.front()) + " at the guess to " +
-             format_residual(out.residual_norm) + (out.rank < out.unknowns ? ", and the Jacobian there has rank " +
-                                                       std::to_string(out.rank) + " of " + std::to_string(out.unknowns)
-                                                                           : std::string()) +
-             ": try multiple shooting with more segments, a smaller h, or a better guess";
-    else if (out.residual_norm < 1e3 && !so.residual_history.empty() &&
-             so.residual_history.front() > 1e3 * out.residual_norm) {
+    std::string msg;
+    if (so.residual_history.empty() || !std::isfinite(out.residual_norm)) {
+      msg = "the shooting residual is not finite at the guess (the flow overflows from it): try multiple shooting with "
+            "more segments, a smaller h, or a better guess";
+    } else if (diverged) {
+      msg = "the residual grew from " + format_residual(so.residual_history.front()) + " at the guess to " +
+            format_residual(out.residual_norm) + " x tolerance" + rank_note +
+            ": try multiple shooting with more segments, a smaller h, or a better guess";
+    } else if (out.residual_norm < 1e3 && so.residual_history.front() > 1e3 * out.residual_norm) {
       int longest = 0;
       for (int i = 0; i < S; ++i) longest = std::max(longest, starts[i + 1] - starts[i]);
-      msg += "; it stalled close to the tolerance after a " + format_residual(so.residual_history.front() / out.residual_norm) +
-             "-fold reduction: the roundoff floor of the flow on this grid (h = " + format_residual(bvp.h()) + ", " +
-             std::to_string(longest) + " steps per segment): use shorter segments or a looser tolerance";
-    } else if (!so.residual_history.empty()) {
-      msg += "; the residual went from " + format_residual(so.residual_history.front()) + " at the guess to " +
-             format_residual(out.residual_norm) +
-             ": the guess is too far for Newton's method; try a better guess, more segments, or continuation "
-             "in a parameter from an easier problem";
-      if (out.rank < out.unknowns)
-        msg += " (the Jacobian there has rank " + std::to_string(out.rank) + " of " + std::to_string(out.unknowns) + ")";
+      msg = "the residual stalled at " + format_residual(out.residual_norm) + " x tolerance after a " +
+            format_residual(so.residual_history.front() / out.residual_norm) +
+            "-fold reduction, the roundoff floor of the flow on this grid (h = " + format_residual(bvp.h()) + ", " +
+            std::to_string(longest) + " steps per segment): use shorter segments or a looser tolerance";
+    } else {
+      msg = "the residual went only from " + format_residual(so.residual_history.front()) + " at the guess to " +
+            format_residual(out.residual_norm) + " x tolerance" + rank_note +
+            ": the guess is too far for Newton's method; try a better guess, more segments, or continuation in a "
+            "parameter from an easier problem";
     }
     return finish(ShootingStatus::NotConverged, msg);
   }
@@ -212,11 +217,16 @@ ShootingResult<X> solve_bvp_with(const typename SchemeFor<X>::BVP& bvp, const ty
     ShootingResult<X> swept = detail::solve_from_starts<X>(bvp, detail::forward_sweep<X>(bvp, refs, starts, opt.step), starts, opt);
     swept.propagated_starts = true;
     swept.iterations += out.iterations;
+    // The better attempt's sentence stands; both accounts go to the detail.
+    auto account = [](const char* from, const ShootingResult<X>& r) {
+      return std::string("from ") + from + ": " + r.message + (r.detail.empty() ? "" : " [" + r.detail + "]");
+    };
     if (swept.ok() || (swept.status == ShootingStatus::NotConverged && swept.residual_norm < out.residual_norm)) {
-      swept.message = swept.ok() ? "" : swept.message + " (from the guess's segment starts as well: " + out.message + ")";
+      swept.detail = swept.ok() ? "" : account("the forward sweep's segment starts", swept) + "; " +
+                                           account("the guess's segment starts", out);
       out = std::move(swept);
     } else {
-      out.message += " (from the forward sweep's segment starts as well: " + swept.message + ")";
+      out.detail = account("the guess's segment starts", out) + "; " + account("the forward sweep's segment starts", swept);
     }
   }
   out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

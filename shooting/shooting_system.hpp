@@ -18,6 +18,8 @@
 
 #include <algorithm>
 #include <limits>
+#include <exception>
+#include <system_error>
 #include <thread>
 
 namespace lpshoot {
@@ -132,12 +134,27 @@ class ShootingSystem : public NonlinearSystem {
     if (T == 1) {
       for (int i = 0; i < S; ++i) work(i);
     } else {
-      std::vector<std::thread> pool;
-      for (int t = 0; t < T; ++t)
-        pool.emplace_back([&, t] {
+      // Stripe t of the segments on thread t; the calling thread takes stripe 0 and any stripe
+      // whose thread could not be created (no thread is left unjoined, no exception escapes one).
+      std::vector<std::exception_ptr> errors(T);
+      auto stripe = [&](int t) {
+        try {
           for (int i = t; i < S; i += T) work(i);
-        });
+        } catch (...) {
+          errors[t] = std::current_exception();
+        }
+      };
+      std::vector<std::thread> pool;
+      try {
+        for (int t = 1; t < T; ++t) pool.emplace_back(stripe, t);
+      } catch (const std::system_error&) {  // e.g. EAGAIN under a thread or memory limit
+      }
+      const int started = static_cast<int>(pool.size()) + 1;
+      stripe(0);
+      for (int t = started; t < T; ++t) stripe(t);
       for (auto& th : pool) th.join();
+      for (const auto& e : errors)
+        if (e) std::rethrow_exception(e);
     }
     last_failure_.clear();
     for (int i = 0; i < S; ++i)

@@ -5,14 +5,20 @@
 //                [--backend kinsol,nlopt]
 //   lpshoot check SCENE.json
 // Exit codes: 0 converged; 1 the run did not converge (the report says why); 2 bad command line
-// or scene; 3 the results could not be written.
+// or scene; 3 the results could not be written; 4 an internal error or out of memory;
+// 130 / 143 interrupted by SIGINT / SIGTERM (the report says so).
+#include "interrupt.hpp"
 #include "output.hpp"
 
 #include <CLI/CLI.hpp>
 
 #include <unistd.h>
 
+#include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <memory>
+#include <new>
 
 namespace {
 
@@ -25,12 +31,25 @@ struct Common {
   bool no_plot = false, progress = false, quiet = false;
 };
 
+// Progress lines go to a terminal as they come; to a log (stderr not a terminal) at most one
+// every 10 s, so a long run is visibly alive without flooding the log. Every call is also a
+// checkpoint where SIGINT/SIGTERM stop the run.
 Progress progress_printer(const Common& c) {
-  if (c.quiet || !(c.progress || isatty(STDERR_FILENO))) return {};
-  return [](const std::string& line) { std::fprintf(stderr, "  %s\n", line.c_str()); };
+  const bool show = !c.quiet;
+  const bool every_line = c.progress || isatty(STDERR_FILENO);
+  auto last = std::make_shared<std::chrono::steady_clock::time_point>(std::chrono::steady_clock::now());
+  return [show, every_line, last](const std::string& line) {
+    throw_if_interrupted();
+    if (!show) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (!every_line && now - *last < std::chrono::seconds(10)) return;
+    *last = now;
+    std::fprintf(stderr, "  %s\n", line.c_str());
+  };
 }
 
 std::string fmt(const char* f, double x) {
+  if (!std::isfinite(x)) return "not finite";
   char buf[64];
   std::snprintf(buf, sizeof buf, f, x);
   return buf;
@@ -115,9 +134,7 @@ int fail_input(const std::string& what) {
   return 2;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run_command(int argc, char** argv) {
   CLI::App app{"lpshoot: optimal and free trajectories of mechanical systems with symmetry\n"
                "(discrete constrained higher-order Lagrange-Poincare equations, Bloch-Colombo-Jimenez)"};
   app.require_subcommand(1);
@@ -164,6 +181,9 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
+  for (CLI::App* sub : {solve, simulate, sweep})
+    if (sub->parsed() && sub->count("--out") > 0 && c.out.empty())
+      return fail_input("--out: the output directory is empty (give a directory, or leave --out out for the scene's)");
 
   Scene scene;
   try {
@@ -172,6 +192,10 @@ int main(int argc, char** argv) {
       return fail_input(scene.file + ": boundary: " + why);
   } catch (const SceneError& e) {
     return fail_input(e.what());
+  } catch (const std::bad_alloc&) {
+    return fail_input(c.scene + ": the scene is too large to read");
+  } catch (const std::exception& e) {
+    return fail_input(c.scene + ": cannot read the scene: " + e.what());
   }
   if (check->parsed()) {
     std::printf("%s: valid %s scene: N = %d, T = %g, h = %g\n", scene.file.c_str(), scene.problem_name.c_str(), scene.N,
@@ -181,6 +205,15 @@ int main(int argc, char** argv) {
   const std::string dir = c.out.empty() ? scene.out_dir : c.out;
   const bool plot = scene.plot && !c.no_plot;
   const Progress progress = progress_printer(c);
+  const std::string command = sweep->parsed() ? "sweep" : solve->parsed() ? "solve" : "simulate";
+  const auto started = std::chrono::steady_clock::now();
+  std::unique_ptr<OutputDir> out;
+  try {
+    out = std::make_unique<OutputDir>(dir);  // before the work: an unwritable place fails now
+  } catch (const OutputError& e) {
+    std::fprintf(stderr, "lpshoot: cannot write the results: %s\n", e.what());
+    return 3;
+  }
   try {
     if (sweep->parsed()) {
       SweepOptions so;
@@ -195,17 +228,19 @@ int main(int argc, char** argv) {
       so.steps_per_segment = steps_per_segment;
       so.use_exact = reference == "auto";
       const SweepRecord sw = run_sweep(scene, scene.is_optimal_control() ? "solve" : "simulate", so, progress);
+      throw_if_interrupted();
       print_sweep(sw);
-      print_files(write_sweep(scene, sw, dir, plot));
+      print_files(write_sweep(scene, sw, *out, plot));
       if (!sw.all_converged) {
         std::fprintf(stderr, "lpshoot: not every run converged: %s\n", sw.message.c_str());
         return 1;
       }
       return 0;
     }
-    const RunRecord r = run_scene(solve->parsed() ? "solve" : "simulate", scene, progress);
+    const RunRecord r = run_scene(command, scene, progress);
+    throw_if_interrupted();
     print_run(r);
-    print_files(write_run(scene, r, dir, plot));
+    print_files(write_run(scene, r, *out, plot));
     if (!r.converged) {
       std::fprintf(stderr, "lpshoot: %s: %s\n", r.status.c_str(), r.message.c_str());
       return 1;
@@ -216,8 +251,34 @@ int main(int argc, char** argv) {
   } catch (const OutputError& e) {
     std::fprintf(stderr, "lpshoot: cannot write the results: %s\n", e.what());
     return 3;
+  } catch (const Interrupted& e) {
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    std::fprintf(stderr, "lpshoot: %s after %.1f s; the report says so\n", e.what(), elapsed);
+    try {
+      OutputDir fresh(dir);  // the one that was being written may hold partial files
+      print_files(write_interrupted(scene, command, fresh, e.what(), elapsed));
+    } catch (const std::exception& w) {
+      std::fprintf(stderr, "lpshoot: could not write the report: %s\n", w.what());
+    }
+    return 128 + e.signal;
+  }
+}
+
+}  // namespace
+
+// The one place every failure becomes a message and an exit code (2 input, 3 output, 4 internal).
+int main(int argc, char** argv) {
+  install_interrupt_handlers();
+  try {
+    return run_command(argc, argv);
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "lpshoot: out of memory: the problem is too large for this machine (try a smaller N)\n");
+    return 4;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "lpshoot: internal error: %s\n", e.what());
+    return 4;
+  } catch (...) {
+    std::fprintf(stderr, "lpshoot: internal error (unknown exception)\n");
     return 4;
   }
 }

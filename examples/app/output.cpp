@@ -3,11 +3,17 @@
 
 #include <nlohmann/json.hpp>
 
+#include "interrupt.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cerrno>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -18,37 +24,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using json = nlohmann::ordered_json;
-
-void ensure_dir(const fs::path& dir) {
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir)) throw OutputError(dir.string() + ": cannot create the output directory" + (ec ? ": " + ec.message() : ""));
-}
-
-// Writes to DIR/.NAME.tmp, then renames over DIR/NAME.
-void write_atomic(const fs::path& dir, const std::string& name, const std::string& content) {
-  const fs::path tmp = dir / ("." + name + ".tmp"), dst = dir / name;
-  {
-    std::ofstream f(tmp, std::ios::binary);
-    f << content;
-    f.close();
-    if (!f) {
-      std::error_code ec;
-      fs::remove(tmp, ec);
-      throw OutputError(dst.string() + ": cannot write");
-    }
-  }
-  std::error_code ec;
-  fs::rename(tmp, dst, ec);
-  if (ec) throw OutputError(dst.string() + ": cannot move into place: " + ec.message());
-}
-
-void remove_stale(const fs::path& dir, const std::vector<std::string>& names) {
-  for (const auto& n : names) {
-    std::error_code ec;
-    fs::remove(dir / n, ec);
-  }
-}
 
 std::string number(double x) {  // full precision; empty for "no value"
   if (!std::isfinite(x)) return "";
@@ -70,44 +45,73 @@ std::string csv(const Table& t) {
 
 json finite_or_null(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
 
-std::string quote_shell(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
+// Pretty JSON; text that is not UTF-8 (a file name from the command line) is written with U+FFFD.
+std::string dump(const json& j) { return j.dump(2, ' ', false, json::error_handler_t::replace) + "\n"; }
+
+// True when FILE is a whole PNG (it ends with the IEND chunk): a full disk can leave a
+// truncated image behind a gnuplot that exits 0.
+bool complete_png(const fs::path& file) {
+  std::ifstream f(file, std::ios::binary | std::ios::ate);
+  if (!f || f.tellg() < 20) return false;
+  f.seekg(-8, std::ios::end);
+  char tail[8];
+  f.read(tail, 8);
+  return f && std::string(tail, 4) == "IEND";
 }
 
-// Runs gnuplot on DIR/plot.gp (which writes .NAME.tmp files), then moves each PNG into place.
-void run_gnuplot(const fs::path& dir, const std::string& script, const std::vector<std::string>& pngs, Written& w) {
-  write_atomic(dir, "plot.gp", script);
-  remove_stale(dir, pngs);
-  const std::string cmd = "cd " + quote_shell(dir.string()) + " && gnuplot plot.gp > .gnuplot.log 2>&1";
-  const int rc = std::system(cmd.c_str());
-  const int code = rc == -1 ? -1 : WEXITSTATUS(rc);
+// Runs gnuplot on plot.gp in the staging directory (which writes the PNGs there). gnuplot runs
+// as a child that SIGINT/SIGTERM reach (std::system would make this process ignore them).
+void run_gnuplot(OutputDir& out, const std::string& script, const std::vector<std::string>& pngs, Written& w) {
+  out.write("plot.gp", script);
+  w.files.push_back(out.final_path("plot.gp"));
+  const fs::path log = out.staging() / ".gnuplot.log";
+  const pid_t pid = fork();
+  if (pid == 0) {
+    if (chdir(out.staging().c_str()) != 0) _exit(126);
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd >= 0) dup2(fd, 1), dup2(fd, 2);
+    execlp("gnuplot", "gnuplot", "plot.gp", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  int status = 0;
+  bool waited = pid > 0;
+  while (waited && waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) {
+      waited = false;
+      break;
+    }
+    if (interrupt_signal()) kill(pid, SIGTERM);  // then reap it
+  }
+  throw_if_interrupted();
+  const int code = !waited ? -1 : WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  std::string first_line;
+  {
+    std::ifstream f(log);
+    std::getline(f, first_line);
+  }
+  std::error_code ec;
+  fs::remove(log, ec);
   if (code != 0) {
     std::string why = code == 127 ? "gnuplot is not installed (apt-get install gnuplot-nox)" : "gnuplot failed";
-    std::ifstream log(dir / ".gnuplot.log");
-    std::string line;
-    if (code != 127 && std::getline(log, line)) why += ": " + line;
-    w.warnings.push_back("plots skipped: " + why + " (script kept in " + (dir / "plot.gp").string() + ")");
-    for (const auto& p : pngs) remove_stale(dir, {"." + p + ".tmp"});
+    if (code != 127 && !first_line.empty()) why += ": " + first_line;
+    w.warnings.push_back("plots skipped: " + why + " (script kept in " + out.final_path("plot.gp") + ")");
+    for (const auto& p : pngs) fs::remove(out.staging() / p, ec);
     return;
   }
-  remove_stale(dir, {".gnuplot.log"});
   for (const auto& p : pngs) {
-    std::error_code ec;
-    fs::rename(dir / ("." + p + ".tmp"), dir / p, ec);
-    if (ec)
-      w.warnings.push_back("plot " + p + " was not produced");
-    else
-      w.files.push_back((dir / p).string());
+    if (complete_png(out.staging() / p)) {
+      w.files.push_back(out.final_path(p));
+    } else {
+      fs::remove(out.staging() / p, ec);
+      w.warnings.push_back("plot " + p + " was not produced in full (disk full?)");
+    }
   }
-  w.files.push_back((dir / "plot.gp").string());
 }
 
 std::string gp_header(const std::string& out, int width, int height) {
   std::ostringstream s;
   s << "set terminal pngcairo size " << width << "," << height << " font ',10'\n"
-    << "set output '." << out << ".tmp'\n";
+    << "set output '" << out << "'\n";
   return s.str();
 }
 
@@ -166,34 +170,24 @@ std::string run_plot_script(const Scene& scene, const RunRecord& r, bool momentu
 
 }  // namespace
 
-Written write_run(const Scene& scene, const RunRecord& r, const std::string& dir_name, bool plot) {
-  const fs::path dir(dir_name);
-  ensure_dir(dir);
+Written write_run(const Scene& scene, const RunRecord& r, OutputDir& out, bool plot) {
   Written w;
-  const std::vector<std::string> results = {"trajectory.csv", "trajectory_extrapolated.csv", "momentum.csv",
-                                            "trajectory.png", "momentum.png", "plot.gp"};
-  if (r.converged) {
-    write_atomic(dir, "trajectory.csv", csv(r.trajectory));
-    w.files.push_back((dir / "trajectory.csv").string());
+  if (r.converged) {  // a failed run writes its report only
+    out.write("trajectory.csv", csv(r.trajectory));
+    w.files.push_back(out.final_path("trajectory.csv"));
     if (r.error_estimate && r.error_estimate->extrapolation_order > 0) {
-      write_atomic(dir, "trajectory_extrapolated.csv", csv(r.error_estimate->extrapolated));
-      w.files.push_back((dir / "trajectory_extrapolated.csv").string());
-    } else {
-      remove_stale(dir, {"trajectory_extrapolated.csv"});
+      out.write("trajectory_extrapolated.csv", csv(r.error_estimate->extrapolated));
+      w.files.push_back(out.final_path("trajectory_extrapolated.csv"));
     }
     if (r.has_momentum) {
-      write_atomic(dir, "momentum.csv", csv(r.momentum));
-      w.files.push_back((dir / "momentum.csv").string());
-    } else {
-      remove_stale(dir, {"momentum.csv", "momentum.png"});
+      out.write("momentum.csv", csv(r.momentum));
+      w.files.push_back(out.final_path("momentum.csv"));
     }
     if (plot) {
       std::vector<std::string> pngs = {"trajectory.png"};
       if (r.has_momentum) pngs.push_back("momentum.png");
-      run_gnuplot(dir, run_plot_script(scene, r, r.has_momentum), pngs, w);
+      run_gnuplot(out, run_plot_script(scene, r, r.has_momentum), pngs, w);
     }
-  } else {
-    remove_stale(dir, results);  // never leave a previous run's results next to a failed report
   }
 
   json j;
@@ -202,6 +196,7 @@ Written write_run(const Scene& scene, const RunRecord& r, const std::string& dir
   j["status"] = r.status;
   j["converged"] = r.converged;
   j["message"] = r.message;
+  if (!r.detail.empty()) j["detail"] = r.detail;
   j["problem"] = r.problem;
   j["scene_file"] = scene.file;
   j["T"] = r.T;
@@ -269,17 +264,16 @@ Written write_run(const Scene& scene, const RunRecord& r, const std::string& dir
   json fin = json::object();
   for (const auto& [k, v] : r.final_state) fin[k] = finite_or_null(v);
   j["final_state"] = fin;
-  w.files.insert(w.files.begin(), (dir / "report.json").string());
+  w.files.insert(w.files.begin(), out.final_path("report.json"));
   j["files"] = w.files;
   j["warnings"] = w.warnings;
   j["scene"] = json::parse(scene.effective_json);
-  write_atomic(dir, "report.json", j.dump(2) + "\n");
+  out.write("report.json", dump(j));
+  out.commit();
   return w;
 }
 
-Written write_sweep(const Scene& scene, const SweepRecord& sw, const std::string& dir_name, bool plot) {
-  const fs::path dir(dir_name);
-  ensure_dir(dir);
+Written write_sweep(const Scene& scene, const SweepRecord& sw, OutputDir& out, bool plot) {
   Written w;
   // The CSV carries the solver as text columns; build it by hand.
   std::string s = "N,h,scheme,method,backend,segments,converged,error,order,cost,cost_error,wall_time_s,iterations,"
@@ -291,8 +285,8 @@ Written write_sweep(const Scene& scene, const SweepRecord& sw, const std::string
          number(r.cost) + "," + number(r.cost_error) + "," + number(r.wall_time_s) + "," + std::to_string(r.iterations) +
          "," + number(r.momentum_drift) + "\n";
   }
-  write_atomic(dir, "sweep.csv", s);
-  w.files.push_back((dir / "sweep.csv").string());
+  out.write("sweep.csv", s);
+  w.files.push_back(out.final_path("sweep.csv"));
   if (plot) {
     std::ostringstream g;
     g << "# lpshoot sweep plot: run `gnuplot plot.gp` in this directory to redraw.\n"
@@ -315,7 +309,7 @@ Written write_sweep(const Scene& scene, const SweepRecord& sw, const std::string
         << "', '' skip 1 using 12:" << sel << ":1 with labels offset 0,1 notitle";
     }
     g << "\nset output\n";
-    run_gnuplot(dir, g.str(), {"sweep_error_time.png"}, w);
+    run_gnuplot(out, g.str(), {"sweep_error_time.png"}, w);
   }
   json j;
   j["lpshoot_version"] = "0.1.0";
@@ -344,11 +338,33 @@ Written write_sweep(const Scene& scene, const SweepRecord& sw, const std::string
     x["momentum_drift"] = r.momentum_drift;
     j["runs"].push_back(x);
   }
-  w.files.insert(w.files.begin(), (dir / "sweep.json").string());
+  w.files.insert(w.files.begin(), out.final_path("sweep.json"));
   j["files"] = w.files;
   j["warnings"] = w.warnings;
   j["scene"] = json::parse(scene.effective_json);
-  write_atomic(dir, "sweep.json", j.dump(2) + "\n");
+  out.write("sweep.json", dump(j));
+  out.commit();
+  return w;
+}
+
+Written write_interrupted(const Scene& scene, const std::string& command, OutputDir& out, const std::string& why,
+                          double wall_time_s) {
+  Written w;
+  json j;
+  j["lpshoot_version"] = "0.1.0";
+  j["command"] = command;
+  j["status"] = "interrupted";
+  j["converged"] = false;
+  j["message"] = why + " before the run finished; no results were kept";
+  j["problem"] = scene.problem_name;
+  j["scene_file"] = scene.file;
+  j["wall_time_s"] = wall_time_s;
+  const std::string name = command == "sweep" ? "sweep.json" : "report.json";
+  w.files.push_back(out.final_path(name));
+  j["files"] = w.files;
+  j["scene"] = json::parse(scene.effective_json);
+  out.write(name, dump(j));
+  out.commit();
   return w;
 }
 

@@ -105,10 +105,41 @@ void estimate_error(const Scene& s, RunRecord& r, const Progress& progress) {
   r.error_estimate = e;
 }
 
+// Why a converged run's results are not all finite, or "". Tables mark "no value at this node"
+// with NaN only in their first and last few rows (one-sided windows, the last interval's
+// velocity); a NaN inside, or an infinity anywhere, is a failure. Names the first bad node.
+std::string non_finite_result(const RunRecord& r) {
+  auto scalar = [](const char* name, double x) { return std::isfinite(x) ? std::string() : std::string(name); };
+  for (const std::string& why : {scalar("cost", r.has_cost ? r.cost : 0.0), scalar("action", r.action),
+                                 scalar("momentum drift", r.momentum_drift),
+                                 scalar("mechanical momentum drift", r.physical_momentum_drift)})
+    if (!why.empty()) return "the " + why + " is not finite";
+  for (const auto& [name, x] : r.final_state)
+    if (!std::isfinite(x)) return "the final " + name + " is not finite";
+  for (const Table* t : {&r.trajectory, &r.momentum}) {
+    const size_t rows = t->rows(), edge = 4;
+    for (size_t n = 0; n < rows; ++n)
+      for (size_t c = 0; c < t->columns.size(); ++c) {
+        const double x = t->columns[c][n];
+        if (std::isinf(x) || (std::isnan(x) && n >= edge && n + edge < rows))
+          return t->names[c] + " is not finite from node n = " + std::to_string(n) + " (t = " +
+                 format_number(t->columns[0][n]) + ") on";
+      }
+  }
+  return "";
+}
+
 }  // namespace
 
 RunRecord run_scene(const std::string& command, const Scene& s, const Progress& progress) {
   RunRecord r = run_one(command, s, progress);
+  if (r.converged) {
+    if (const std::string why = non_finite_result(r); !why.empty()) {
+      r.converged = false;
+      r.status = "non_finite";
+      r.message = why + ": the numbers overflowed (check the scene's magnitudes: parameters, boundary data, T)";
+    }
+  }
   if (s.error_estimate && r.converged) estimate_error(s, r, progress);
   return r;
 }

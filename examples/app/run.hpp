@@ -32,7 +32,8 @@ struct Table {
 struct RunRecord {
   std::string command;  // "solve" or "simulate"
   bool converged = false;
-  std::string status, message;
+  std::string status, message;  // message: one sentence (what failed, why, what to try)
+  std::string detail;           // the solver's own account, in report.json only
   std::string problem;
   int N = 0;
   double T = 0, h = 0;

@@ -90,6 +90,7 @@ void record_outcome(const ShootingResult<P>& res, RunRecord& r) {
   r.converged = res.ok();
   r.status = status_name(res.status);
   r.message = res.ok() ? "converged in " + std::to_string(res.iterations) + " iterations" : res.message;
+  r.detail = res.detail;
   if (res.ok() && res.propagated_starts)  // the scenes use SegmentStarts::Auto
     r.message += ", counting a failed attempt from the guess's segment starts before the forward sweep's";
   if (res.ok() && !r.continuation_path.empty())

@@ -9,6 +9,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <unistd.h>
+
 namespace lpshoot::app {
 namespace {
 
@@ -153,20 +155,138 @@ class Reader {
   const std::string& file_;
 };
 
+// The deepest nesting a scene may have: real scenes need 4 levels; a limit keeps a hostile file
+// (10^5 levels) from exhausting memory or the stack while it is read.
+constexpr int max_json_depth = 64;
+
+// A SAX pass before the document is built: rejects nesting deeper than max_json_depth and
+// duplicate keys in one object (nlohmann keeps the last one silently). Throws SceneError;
+// returns false on a syntax error, which the DOM parse then describes.
+class JsonPrecheck : public nlohmann::json_sax<json> {
+ public:
+  explicit JsonPrecheck(std::string where) : where_(std::move(where)) {}
+  bool null() override { return true; }
+  bool boolean(bool) override { return true; }
+  bool number_integer(number_integer_t) override { return true; }
+  bool number_unsigned(number_unsigned_t) override { return true; }
+  bool number_float(number_float_t, const string_t&) override { return true; }
+  bool string(string_t&) override { return true; }
+  bool binary(binary_t&) override { return true; }
+  bool start_object(std::size_t) override { return open(true); }
+  bool end_object() override { return close(); }
+  bool start_array(std::size_t) override { return open(false); }
+  bool end_array() override { return close(); }
+  bool key(string_t& k) override {
+    auto& keys = stack_.back().keys;
+    if (std::find(keys.begin(), keys.end(), k) != keys.end())
+      throw SceneError(where_ + ": duplicate key \"" + k + "\" in one object" + at() + " (JSON keeps only one; remove the other)");
+    keys.push_back(k);
+    return true;
+  }
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) override { return false; }
+
+ private:
+  struct Level {
+    bool object;
+    std::vector<std::string> keys;
+  };
+  bool open(bool object) {
+    if (static_cast<int>(stack_.size()) >= max_json_depth)
+      throw SceneError(where_ + ": nested more than " + std::to_string(max_json_depth) +
+                       " levels deep; a scene needs a handful");
+    stack_.push_back({object, {}});
+    return true;
+  }
+  bool close() {
+    stack_.pop_back();
+    return true;
+  }
+  std::string at() const {  // the enclosing keys, e.g. " (at boundary.initial)"
+    std::string path;
+    for (size_t i = 0; i + 1 < stack_.size(); ++i)
+      if (stack_[i].object && !stack_[i].keys.empty()) path += (path.empty() ? "" : ".") + stack_[i].keys.back();
+    return path.empty() ? "" : " (at " + path + ")";
+  }
+  std::string where_;
+  std::vector<Level> stack_;
+};
+
+// Parses JSON text; `where` names the file or option in messages. Throws SceneError.
+json parse_json_text(const std::string& text, const std::string& where) {
+  JsonPrecheck check(where);
+  json::sax_parse(text, &check);  // throws on depth or duplicates; syntax errors are described below
+  try {
+    return json::parse(text);
+  } catch (const json::exception& e) {  // parse errors, invalid UTF-8, numbers out of range (1e999)
+    std::string what = e.what();  // "[json.exception.parse_error.101] parse error at line 3, column 5: ..."
+    const size_t at = what.find("] ");
+    throw SceneError(where + ": invalid JSON: " + (at == std::string::npos ? what : what.substr(at + 2)));
+  }
+}
+
+// The whole scene file, or a SceneError saying why it cannot be read.
+std::string read_scene_file(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (ec || !fs::exists(st)) throw SceneError(path + ": cannot read the scene file: no such file");
+  if (fs::is_directory(st)) throw SceneError(path + ": cannot read the scene file: it is a directory");
+  if (!fs::is_regular_file(st)) throw SceneError(path + ": cannot read the scene file: not a regular file");
+  constexpr std::uintmax_t max_bytes = 16u << 20;
+  if (const std::uintmax_t size = fs::file_size(path, ec); !ec && size > max_bytes)
+    throw SceneError(path + ": cannot read the scene file: " + std::to_string(size >> 20) + " MB is too large for a scene");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError(path + ": cannot read the scene file: permission denied or unreadable");
+  std::string text;
+  char buf[65536];
+  while (in.read(buf, sizeof buf) || in.gcount() > 0) {
+    text.append(buf, static_cast<size_t>(in.gcount()));
+    if (text.size() > max_bytes) throw SceneError(path + ": cannot read the scene file: too large for a scene");
+  }
+  if (in.bad()) throw SceneError(path + ": cannot read the scene file: a read error occurred");
+  return text;
+}
+
 // ---------------------------------------------------------------- --set overrides
 
+// A key path component as an array index: digits only, at most 9 of them; nullopt otherwise.
+std::optional<size_t> array_index(const std::string& k) {
+  if (k.empty() || k.size() > 9 || k.find_first_not_of("0123456789") != std::string::npos) return std::nullopt;
+  return static_cast<size_t>(std::stoul(k));
+}
+
+// Well-formed UTF-8 (no overlongs, surrogates or code points past U+10FFFF): what JSON text may hold.
+bool valid_utf8(const std::string& s) {
+  const auto* p = reinterpret_cast<const unsigned char*>(s.data());
+  const size_t n = s.size();
+  for (size_t i = 0; i < n;) {
+    const unsigned c = p[i];
+    int len = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+    if (len == 0 || i + len > n) return false;
+    unsigned cp = len == 1 ? c : c & (0x7F >> len);
+    for (int j = 1; j < len; ++j) {
+      if ((p[i + j] & 0xC0) != 0x80) return false;
+      cp = (cp << 6) | (p[i + j] & 0x3F);
+    }
+    if ((len == 2 && cp < 0x80) || (len == 3 && cp < 0x800) || (len == 4 && cp < 0x10000) || cp > 0x10FFFF ||
+        (cp >= 0xD800 && cp <= 0xDFFF))
+      return false;
+    i += len;
+  }
+  return true;
+}
+
 void apply_override(json& scene, const std::string& assignment) {
+  if (!valid_utf8(assignment)) throw SceneError("--set: the argument is not valid UTF-8 text");
   const size_t eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0)
     throw SceneError("--set '" + assignment + "': expected key.path=value (e.g. horizon.N=400)");
   const std::string path = assignment.substr(0, eq), text = assignment.substr(eq + 1);
   json value;
-  try {
-    value = json::parse(text);
-  } catch (const json::parse_error&) {
+  if (json::accept(text)) {
+    value = parse_json_text(text, "--set " + path);  // depth and duplicate keys checked
+  } else {
     value = text;  // a bare word: a string
-  } catch (const json::exception& e) {
-    throw SceneError("--set '" + assignment + "': the value cannot be read (" + e.what() + ")");
   }
   std::vector<std::string> keys;
   std::stringstream ss(path);
@@ -179,12 +299,9 @@ void apply_override(json& scene, const std::string& assignment) {
     const std::string& k = keys[i];
     const bool last = i + 1 == keys.size();
     if (node->is_array()) {  // numeric component: an array element
-      size_t idx = 0;
-      try {
-        idx = std::stoul(k);
-      } catch (const std::exception&) {
-        throw SceneError("--set '" + assignment + "': '" + k + "' must be an index into the array at that point");
-      }
+      const std::optional<size_t> index = array_index(k);
+      if (!index) throw SceneError("--set '" + assignment + "': '" + k + "' must be an index into the array at that point");
+      const size_t idx = *index;
       if (idx >= node->size())
         throw SceneError("--set '" + assignment + "': index " + k + " is past the end of an array of " +
                          std::to_string(node->size()));
@@ -192,7 +309,8 @@ void apply_override(json& scene, const std::string& assignment) {
     } else {
       if (node->is_null()) *node = json::object();
       if (!node->is_object())
-        throw SceneError("--set '" + assignment + "': '" + keys[i - 1] + "' is not an object");
+        throw SceneError("--set '" + assignment + "': " +
+                         (i == 0 ? std::string("the scene is not a JSON object") : "'" + keys[i - 1] + "' is not an object"));
       if (last && value.is_null()) {
         node->erase(k);  // "null" makes the entry free / default
         return;
@@ -211,8 +329,12 @@ void read_solver(const Reader& r, Scene& s) {
   if (s.problem == ProblemKind::BeanieFree) {  // a simulation: only the per-step Newton is tuned
     r.allow({"tolerance", "max_iterations"});
     s.shooting.step.step_tolerance = r.positive("tolerance", s.shooting.step.step_tolerance);
-    if (s.shooting.step.step_tolerance < 1e-15 || s.shooting.step.step_tolerance > 1)
-      r.fail("must be between 1e-15 and 1 (got " + Reader::format(s.shooting.step.step_tolerance) + ")", "tolerance");
+    // A relative Newton correction per step: above 1e-6 a step is not solved to an accuracy worth
+    // reporting (the run would "converge" on a first guess).
+    if (s.shooting.step.step_tolerance < 1e-15 || s.shooting.step.step_tolerance > 1e-6)
+      r.fail("must be between 1e-15 and 1e-6, a relative Newton correction per step (got " +
+                 Reader::format(s.shooting.step.step_tolerance) + ")",
+             "tolerance");
     s.shooting.step.max_iterations = r.integer("max_iterations", s.shooting.step.max_iterations);
     if (s.shooting.step.max_iterations < 1) r.fail("must be >= 1", "max_iterations");
     return;
@@ -328,16 +450,6 @@ void read_beanie_free(const Reader& root, Scene& s) {
   }
 }
 
-json parse_json(std::istream& in, const std::string& path) {
-  try {
-    return json::parse(in);
-  } catch (const json::exception& e) {  // parse errors, and numbers out of range (1e999)
-    std::string what = e.what();  // "[json.exception.parse_error.101] parse error at line 3, column 5: ..."
-    const size_t at = what.find("] ");
-    throw SceneError(path + ": invalid JSON: " + (at == std::string::npos ? what : what.substr(at + 2)));
-  }
-}
-
 Scene parse_scene(const json& j, const std::string& path);
 
 void read_continuation(const Reader& so, const json& scene, Scene& s) {
@@ -352,9 +464,8 @@ void read_continuation(const Reader& so, const json& scene, Scene& s) {
   for (std::string k; node && std::getline(ss, k, '.');) {
     if (node->is_object() && node->contains(k))
       node = &(*node)[k];
-    else if (node->is_array() && !k.empty() && k.find_first_not_of("0123456789") == std::string::npos &&
-             std::stoul(k) < node->size())
-      node = &(*node)[std::stoul(k)];
+    else if (const std::optional<size_t> i = array_index(k); node->is_array() && i && *i < node->size())
+      node = &(*node)[*i];
     else
       node = nullptr;
   }
@@ -380,16 +491,13 @@ void read_continuation(const Reader& so, const json& scene, Scene& s) {
 }  // namespace
 
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
-  std::ifstream in(path);
-  if (!in) throw SceneError(path + ": cannot open the scene file");
-  json j = parse_json(in, path);
+  json j = parse_json_text(read_scene_file(path), path);
   for (const auto& o : overrides) apply_override(j, o);
   return parse_scene(j, path);
 }
 
 Scene with_parameter(const Scene& s, const std::string& parameter, double value) {
-  std::istringstream in(s.effective_json);
-  json j = parse_json(in, s.file);
+  json j = parse_json_text(s.effective_json, s.file);
   if (j.contains("solver") && j["solver"].is_object()) j["solver"].erase("continuation");
   apply_override(j["parameters"], parameter + "=" + Reader::format_exact(value));
   return parse_scene(j, s.file);
@@ -477,6 +585,7 @@ Scene parse_scene(const json& j, const std::string& path) {
     read_continuation(*so, j, s);
   } else
     read_solver(Reader(json::object(), "solver", path), s);
+  if (const std::string why = resource_problem(s); !why.empty()) hz.fail(why, "N");
 
   const std::string stem = std::filesystem::path(path).stem().string();
   s.out_dir = "lpshoot-out/" + stem;
@@ -490,6 +599,30 @@ Scene parse_scene(const json& j, const std::string& path) {
 }
 
 }  // namespace
+
+std::string resource_problem(const Scene& s) {
+  // Measured peak memory is 0.4-0.6 kB per step (trajectory, step sensitivities, CSV columns);
+  // multiple shooting also holds its dense Jacobian, its LU and the diagnostics' copies (issue 9
+  // makes that structured). 12 unknowns per segment bound every scheme's state.
+  const double per_step = 1024.0;
+  const double unknowns = s.shooting.method == ShootingMethod::Multiple ? 12.0 * s.shooting.segments : 0.0;
+  const double bytes = per_step * s.N + 4 * 8.0 * unknowns * unknowns;
+  const double available = 0.75 * double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
+  if (!(available > 0) || bytes <= available) return "";
+  char buf[400];
+  if (4 * 8.0 * unknowns * unknowns > per_step * s.N)
+    std::snprintf(buf, sizeof buf,
+                  "%d steps in %d multiple-shooting segments need an estimated %.3g GB (a dense Jacobian of about "
+                  "%.0f unknowns), more than 3/4 of this machine's %.3g GB; use fewer segments (solver.segments), "
+                  "single shooting, or a smaller N",
+                  s.N, s.shooting.segments, bytes / 1e9, unknowns, available / 0.75 / 1e9);
+  else
+    std::snprintf(buf, sizeof buf,
+                  "%d steps need an estimated %.3g GB of memory (about 1 kB per step), more than 3/4 of this "
+                  "machine's %.3g GB; use a smaller N",
+                  s.N, bytes / 1e9, available / 0.75 / 1e9);
+  return buf;
+}
 
 bool set_scheme(Scene& s, const std::string& name) {
   if (name == "paper") {

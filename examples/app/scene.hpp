@@ -83,6 +83,10 @@ struct Scene {
   std::string scheme_name() const { return galerkin() ? "galerkin" + std::to_string(galerkin_order) : "paper"; }
 };
 
+// Why the scene cannot run on this machine (its estimated memory exceeds 3/4 of the physical
+// memory), or "". Checked when a scene is read and for every grid of a sweep.
+std::string resource_problem(const Scene& s);
+
 // Sets the scheme from a name scheme_name() gives; false for an unknown name.
 bool set_scheme(Scene& s, const std::string& name);
 

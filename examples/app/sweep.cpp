@@ -63,24 +63,29 @@ SweepRecord run_sweep(const Scene& scene, const std::string& command, const Swee
   for (ShootingMethod m : opt.methods.empty() ? std::vector{scene.shooting.method} : opt.methods)
     for (Backend b : opt.backends.empty() ? std::vector{scene.shooting.solver.backend} : opt.backends)
       if (scene.is_optimal_control() || solvers.empty()) solvers.emplace_back(m, b);
-  const size_t total = schemes.size() * solvers.size() * grids.size();
-  std::vector<RunRecord> full;
+  // Every run planned (and checked against the machine's memory) before any is started.
+  struct Planned {
+    Scene scene;
+    SweepRun run;
+    std::string label;
+  };
+  std::vector<Planned> plan;
   for (const Scene& base : schemes)
     for (const auto& [m, b] : solvers)
       for (int N : grids) {
-        Scene s = base;
+        Planned p{base, SweepRun(), "N = " + std::to_string(N)};
+        Scene& s = p.scene;
+        SweepRun& sr = p.run;
         s.N = N;
         s.error_estimate = false;  // the sweep measures errors itself
-        SweepRun sr;
         sr.N = N;
         sr.h = s.h();
-        std::string label = "N = " + std::to_string(N);
         if (scene.is_optimal_control()) {
           s.shooting.method = m;
           s.shooting.solver.backend = b;
           int segments = scene.shooting.segments;
-          if (opt.steps_per_segment > 0)
-            segments = (N + opt.steps_per_segment - 1) / opt.steps_per_segment;
+          if (opt.steps_per_segment > 0)  // ceil(N / steps), without overflowing int
+            segments = static_cast<int>((static_cast<long long>(N) + opt.steps_per_segment - 1) / opt.steps_per_segment);
           else if (scene.auto_segments || scene.shooting.method == ShootingMethod::Single)
             segments = s.default_segments(N);  // per grid (a single-shooting scene: multiple shooting's default)
           s.shooting.segments = std::clamp(segments, 1, s.max_segments(N));
@@ -88,26 +93,32 @@ SweepRecord run_sweep(const Scene& scene, const std::string& command, const Swee
           sr.method = method_name(m);
           sr.backend = backend_name(b);
           sr.segments = m == ShootingMethod::Multiple ? s.shooting.segments : 1;
-          label += ", " + sr.scheme + ", " + sr.method + " shooting" +
-                   (m == ShootingMethod::Multiple ? " (" + std::to_string(sr.segments) + " segments)" : "") + ", " +
-                   sr.backend;
+          p.label += ", " + sr.scheme + ", " + sr.method + " shooting" +
+                     (m == ShootingMethod::Multiple ? " (" + std::to_string(sr.segments) + " segments)" : "") + ", " +
+                     sr.backend;
         }
-        if (progress) progress("[" + std::to_string(full.size() + 1) + "/" + std::to_string(total) + "] " + label);
-        full.push_back(run_scene(command, s, Progress()));
-        const RunRecord& r = full.back();
-        sr.converged = r.converged;
-        sr.status = r.status;
-        sr.message = r.message;
-        sr.iterations = r.iterations;
-        sr.wall_time_s = r.wall_time_s;
-        sr.momentum_drift = r.momentum_drift;
-        if (r.has_cost) sr.cost = r.cost;
-        rec.runs.push_back(sr);
-        if (!r.converged && rec.all_converged) {
-          rec.all_converged = false;
-          rec.message = label + ": " + r.status + ": " + r.message;
-        }
+        if (const std::string why = resource_problem(s); !why.empty()) throw SceneError("--N: " + p.label + ": " + why);
+        plan.push_back(std::move(p));
       }
+  std::vector<RunRecord> full;
+  for (Planned& p : plan) {
+    if (progress) progress("[" + std::to_string(full.size() + 1) + "/" + std::to_string(plan.size()) + "] " + p.label);
+    full.push_back(run_scene(command, p.scene, Progress()));
+    const RunRecord& r = full.back();
+    SweepRun& sr = p.run;
+    sr.converged = r.converged;
+    sr.status = r.status;
+    sr.message = r.message;
+    sr.iterations = r.iterations;
+    sr.wall_time_s = r.wall_time_s;
+    sr.momentum_drift = r.momentum_drift;
+    if (r.has_cost) sr.cost = r.cost;
+    rec.runs.push_back(sr);
+    if (!r.converged && rec.all_converged) {
+      rec.all_converged = false;
+      rec.message = p.label + ": " + r.status + ": " + r.message;
+    }
+  }
 
   // Reference: the exact oracle, else the finest grid of the first solver.
   for (const auto& r : full)
@@ -117,7 +128,7 @@ SweepRecord run_sweep(const Scene& scene, const std::string& command, const Swee
   size_t ref_index = SIZE_MAX;
   const ExactReference exact = opt.use_exact ? exact_reference(scene, {}) : ExactReference{};
   if (exact.available) {
-    rec.reference = "exact continuous optimum (matrix exponential)";
+    rec.reference = "exact continuous optimum (matrix exponentials on short pieces)";
     ref_cost = exact.cost;
   } else {
     // The first solver's finest run of the highest-order scheme (paper: order 2 at best).

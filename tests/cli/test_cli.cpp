@@ -429,6 +429,10 @@ class BadInput : public ::testing::Test {
  protected:
   void expect_clean_failure(const BadCase& c) {
     const fs::path work = scratch("bad_" + c.name), out = work / "out";
+    write(work / "deep.json", "{\"problem\": \"electron\", \"description\": " + std::string(100000, '[') +
+                                  std::string(100000, ']') + "}");
+    write(work / "dup.json", "{\"problem\": \"electron\", \"horizon\": {\"T\": 1, \"N\": 10, \"N\": 20}}");
+    write(work / "five.json", "5");
     std::string args = c.args;
     for (size_t p; (p = args.find("OUT")) != std::string::npos;) args.replace(p, 3, out.string());
     for (size_t p; (p = args.find("WORK")) != std::string::npos;) args.replace(p, 4, work.string());
@@ -445,12 +449,24 @@ class BadInput : public ::testing::Test {
 TEST_F(BadInput, EachClassFailsCleanlyNamingTheKey) {
   const std::string e = "'" + scene("electron") + "' --out OUT ", b = "'" + scene("beanie") + "' --out OUT ";
   const std::vector<BadCase> cases = {
-      {"missing_file", "solve WORK/none.json --out OUT", "none.json: cannot open the scene file"},
+      {"missing_file", "solve WORK/none.json --out OUT", "none.json: cannot read the scene file: no such file"},
+      {"directory_scene", "solve WORK --out OUT", "cannot read the scene file: it is a directory"},
+      {"invalid_utf8_set", "solve " + e + "--set \"$(printf 'output.dir=\\377')\"", "--set: the argument is not valid UTF-8 text"},
+      {"deep_nesting", "solve WORK/deep.json --out OUT", "deep.json: nested more than 64 levels deep"},
+      {"duplicate_key", "solve WORK/dup.json --out OUT", "dup.json: duplicate key \"N\" in one object (at horizon)"},
+      {"not_an_object", "solve WORK/five.json --out OUT --set a=1", "--set 'a=1': the scene is not a JSON object"},
+      {"huge_index", "solve " + e + "--set 'solver.continuation={\"parameter\":\"B.99999999999999999999\",\"from\":0}'",
+       "parameters.B.99999999999999999999 must be a number given in the scene's parameters"},
+      {"huge_N", "solve " + e + "--set horizon.N=1e9", "horizon.N: 1000000000 steps need an estimated"},
+      {"sweep_huge_N", "sweep " + e + "--N 2147483647", "--N: N = 2147483647"},
+      {"empty_out", "solve '" + scene("electron") + "' --out ''", "--out: the output directory is empty"},
+      {"simulate_loose_tolerance", "simulate '" + scene("beanie_free") + "' --out OUT --set solver.tolerance=1",
+       "solver.tolerance: must be between 1e-15 and 1e-6"},
       {"unknown_key", "solve " + e + "--set horizon.NN=4", "horizon.NN: unknown key (did you mean 'horizon.N'?)"},
       {"unknown_top_key", "solve " + e + "--set solvr.method=single", "solvr: unknown key (did you mean 'solver'?)"},
       {"wrong_size", "solve " + e + "--set parameters.B=[1,2]", "parameters.B: must be an array of 3 numbers"},
       {"wrong_type", "solve " + e + "--set horizon.N=\\\"many\\\"", "horizon.N: must be an integer"},
-      {"non_finite", "solve " + e + "--set parameters.B.0=1e999", "number overflow"},
+      {"non_finite", "solve " + e + "--set parameters.B.0=1e999", "parameters.B[0]: must be a finite number"},
       {"small_N", "solve " + e + "--set horizon.N=4", "horizon.N: must be at least 2k + 1 = 5"},
       {"non_positive_T", "solve " + e + "--set horizon.T=0", "horizon.T: must be > 0"},
       {"bad_choice", "solve " + e + "--set solver.backend=ipopt", "solver.backend: must be one of kinsol, nlopt"},
@@ -485,12 +501,12 @@ TEST_F(BadInput, EachClassFailsCleanlyNamingTheKey) {
        "horizon.N: must be at least 2 for the galerkin discretization"},
       {"galerkin_segments", "solve " + e + "--set 'scheme={\"discretization\": \"galerkin\"}' --set solver.segments=201",
        "solver.segments: must be between 1 and N = 200"},
-      {"unwritable_out", "", "cannot create the output directory", 3},
+      {"unwritable_out", "", "cannot create the directory", 3},
   };
   for (const BadCase& c : cases) {
     SCOPED_TRACE(c.name);
-    if (c.name == "unwritable_out") {  // the run happens; writing fails with exit code 3
-      const fs::path work = scratch("bad_" + c.name);
+    if (c.name == "unwritable_out") {
+      const fs::path work = scratch("bad_" + c.name);  // writing fails with exit code 3, before the solve
       write(work / "file", "a file, not a directory");
       const Outcome o = run_cli("solve '" + scene("electron") + "' --no-plot --out '" + (work / "file" / "sub").string() + "'", work);
       EXPECT_EQ(o.code, 3) << o.err;

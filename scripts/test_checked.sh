@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# The checked build: Debug (Eigen's assertions on) with AddressSanitizer and
+# UndefinedBehaviorSanitizer, in ./build-checked; runs the core and shooting tests, or with
+# --all every test (the application's and the fuzz test included).
+#   bash scripts/test_checked.sh [--all]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+export CCACHE_BASEDIR="$PWD"
+# -O1: the sanitized suite runs in minutes rather than tens of minutes; assertions stay on.
+cmake -S . -B build-checked -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" \
+  -DLPSHOOT_SANITIZE=address,undefined -DLPSHOOT_BUILD_BENCH=OFF >/dev/null
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+if [ "${1:-}" = "--all" ]; then
+  cmake --build build-checked -j "${LPSHOOT_JOBS:-2}"
+  cd build-checked && ctest --output-on-failure -j "${LPSHOOT_JOBS:-2}" --timeout 1800
+else
+  cmake --build build-checked -j "${LPSHOOT_JOBS:-2}" --target lpshoot_core_tests
+  cd build-checked && ctest --output-on-failure -j "${LPSHOOT_JOBS:-2}" -L core --timeout 1800
+fi
