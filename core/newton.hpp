@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <Eigen/LU>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -126,6 +127,8 @@ StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian,
   Eigen::PartialPivLU<Eigen::Matrix<double, n, n>> lu;
   bool refresh = true;
   double last_step = std::numeric_limits<double>::infinity();
+  double last_residual = std::numeric_limits<double>::infinity();
+  constexpr double eps = std::numeric_limits<double>::epsilon();
   for (int it = 1; it <= opt.max_iterations; ++it) {
     rep.iterations = it;
     if (refresh) {
@@ -150,6 +153,19 @@ StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian,
       rep.status = StepStatus::Converged;
       return rep;
     }
+    // At the roundoff floor (tiny h: terms of size 1/h cancel to an O(1) residual) F is rounding
+    // noise and stops decreasing; the correction it yields is then ~ cond(J) u relative, which
+    // may exceed step_tolerance. A fresh-Jacobian step on a stalled residual whose correction is
+    // within that noise (never beyond 1e-8 relative) is converged: another iteration cannot do
+    // better.
+    if (refresh && rep.residual > 0.25 * last_residual) {
+      const double noise = std::min(1e-8, 64 * eps * rep.condition);
+      if (((dz.cwiseAbs().array() - (opt.step_tolerance + noise) * (1.0 + scale.array())) <= 0.0).all()) {
+        rep.status = StepStatus::Converged;
+        return rep;
+      }
+    }
+    last_residual = rep.residual;
     const double size = dz.template lpNorm<Eigen::Infinity>();
     refresh = refresh ? false : !(size <= 0.25 * last_step);  // after a chord step that contracts too slowly
     last_step = size;

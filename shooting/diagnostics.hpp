@@ -26,6 +26,11 @@ struct RankDiagnosis {
 // the rows. Rank by column-pivoted QR; the SVD only when the rank is deficient.
 inline RankDiagnosis diagnose_rank(Eigen::MatrixXd J, const std::vector<std::string>& names, double tolerance) {
   RankDiagnosis out;
+  if (!J.allFinite()) {  // the flow overflowed: no rank to speak of
+    out.rank = -1;
+    out.condition = INFINITY;
+    return out;
+  }
   for (int r = 0; r < J.rows(); ++r) {
     const double norm = J.row(r).lpNorm<Eigen::Infinity>();
     if (norm > 0) J.row(r) /= norm;
@@ -34,6 +39,10 @@ inline RankDiagnosis diagnose_rank(Eigen::MatrixXd J, const std::vector<std::str
     const double norm = J.col(c).lpNorm<Eigen::Infinity>();
     if (norm > 0) J.col(c) /= norm;
   }
+  // Entries below 1e-200 of their row and column scale are rounding of an overflowing flow, not
+  // data; flushed to zero they keep the factorizations away from subnormal arithmetic (Eigen
+  // 3.4's BDCSVD reads outside its arrays on such input).
+  J = (J.array().abs() < 1e-200).select(0.0, J);
   const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(J);
   const Eigen::VectorXd rdiag = qr.matrixR().diagonal().cwiseAbs();
   for (int i = 0; i < rdiag.size(); ++i)

@@ -35,6 +35,7 @@ struct GalerkinScheme {
   using GroupElem = typename G::template Element<double>;
   static constexpr int r = Sch::r, d = Sch::d, ns = Sch::state;
   static constexpr double roundoff_factor = 4;
+  static constexpr const char* floor_remedy = "use fewer steps or a looser tolerance";
   static constexpr int size = ns + d;
 
   // State index = interval index: shooting spans intervals 0 .. N-1.

@@ -191,6 +191,10 @@ struct NodalScheme {
   using Run = FlowResult<P>;
   using GroupElem = GroupElement<P, double>;
   static constexpr double roundoff_factor = 64;
+  // What lifts the roundoff floor when the tolerance is below it (see row_tolerances).
+  static constexpr const char* floor_remedy =
+      "use shorter segments, fewer steps, a looser tolerance, or the Galerkin scheme (scheme.discretization), whose "
+      "node states in increments have no such floor";
   static constexpr int size = BoundaryState<P>::size;
   static constexpr int k = P::order;
 

@@ -10,6 +10,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <functional>
 
 namespace lpshoot {
 
@@ -31,6 +32,9 @@ struct ShootingOptions {
   NewtonOptions step;
   double rank_tolerance = 1e-10;  // singular values of the equilibrated Jacobian below this times the largest count as zero
   int threads = 0;               // 0: one per available core
+  // Called as segments are propagated within one evaluation (segment done, of S): progress for
+  // evaluations that take long (large N); may throw to stop the solve.
+  std::function<void(int, int)> on_segment;
 };
 
 enum class ShootingStatus { Converged, NotConverged, RankDeficient, FlowFailed, InvalidProblem };
@@ -49,7 +53,7 @@ struct ShootingResult {
   double raw_residual_norm = 0;  // max-norm of the conditions in their own units
   // residual_norm: max over rows of |F_i| / tolerance_i (<= 1 at convergence); tolerance_i is the
   // solver tolerance plus the row's roundoff floor (see row_tolerances).
-  int rank = 0, unknowns = 0;
+  int rank = -1, unknowns = 0;  // rank -1: not computed (the flow failed or overflowed there)
   std::vector<std::string> dependent_conditions;  // when rank deficient
   std::vector<double> singular_values;            // of the equilibrated Jacobian, when rank deficient
   double wall_time_s = 0;
@@ -97,6 +101,7 @@ ShootingResult<X> solve_from_starts(const typename SchemeFor<X>::BVP& bvp,
     return out;
   };
   ShootingSystem<X> system(bvp, refs, starts, opt.step, opt.threads);
+  system.set_on_segment(opt.on_segment);
   out.unknowns = system.size();
 
   Eigen::VectorXd x = Eigen::VectorXd::Zero(system.size());
@@ -144,10 +149,13 @@ ShootingResult<X> solve_from_starts(const typename SchemeFor<X>::BVP& bvp,
   // Nor does one where the flow has blown up (conditions off by more than 1e3 in their own units,
   // e.g. a stiff potential from a poor guess): that is a failure to converge, whatever the rank.
   const bool far = so.status != SolverStatus::Converged && !(out.raw_residual_norm <= 1e3);
-  const std::string rank_note = out.rank < out.unknowns ? " (the Jacobian there has rank " + std::to_string(out.rank) +
+  const std::string rank_note = out.rank >= 0 && out.rank < out.unknowns && !far ? " (the Jacobian there has rank " + std::to_string(out.rank) +
                                                               " of " + std::to_string(out.unknowns) + ")"
                                                         : std::string();
-  if (out.rank < out.unknowns && !diverged && !far) {
+  // A tolerance below the scheme's roundoff floor on this grid (row_tolerances): a Jacobian that
+  // looks rank deficient there is the ill-conditioning of the states, not dependent data.
+  const bool below_floor = so.status != SolverStatus::Converged && !diverged && !far && system.floor_ratio() > 1e4;
+  if (out.rank >= 0 && out.rank < out.unknowns && !diverged && !far && !below_floor) {
     std::string msg = "the shooting Jacobian is rank deficient (rank " + std::to_string(out.rank) + " of " +
                       std::to_string(out.unknowns) +
                       "): redundant or inconsistent boundary data, or a discrete problem that is (nearly) singular at "
@@ -166,6 +174,11 @@ ShootingResult<X> solve_from_starts(const typename SchemeFor<X>::BVP& bvp,
       msg = "the residual grew from " + format_residual(so.residual_history.front()) + " at the guess to " +
             format_residual(out.residual_norm) + " x tolerance" + rank_note +
             ": try multiple shooting with more segments, a smaller h, or a better guess";
+    } else if (below_floor) {
+      msg = "the residual stalled at " + format_residual(out.residual_norm) + " x tolerance" + rank_note +
+            ": the tolerance is below the roundoff floor of this scheme at h = " + format_residual(bvp.h()) +
+            " (estimated at " + format_residual(system.floor_ratio()) + " x tolerance on the worst row); " +
+            A::floor_remedy;
     } else if (out.residual_norm < 1e3 && so.residual_history.front() > 1e3 * out.residual_norm) {
       int longest = 0;
       for (int i = 0; i < S; ++i) longest = std::max(longest, starts[i + 1] - starts[i]);

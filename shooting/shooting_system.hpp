@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <limits>
 #include <exception>
+#include <functional>
 #include <system_error>
 #include <thread>
 
@@ -100,6 +101,7 @@ class ShootingSystem : public NonlinearSystem {
     constexpr double u = std::numeric_limits<double>::epsilon();
     const Eigen::ArrayXd floor = A::roundoff_factor * u * (Jd.cwiseAbs() * mag).array();
     t.array() += floor.min(1e4 * tol);  // at most four digits conceded to roundoff: beyond, not converged
+    floor_ratio_ = floor.maxCoeff() / tol;
     // A continuity row of two states cannot be known better than their rounding, u |M| |state|,
     // whatever the tolerance (nodal windows, h = 5e-4, third differences: ~2e-6 for |p| ~ 1).
     // A defect at that level means states equal to the last bit; this part is not capped.
@@ -132,14 +134,20 @@ class ShootingSystem : public NonlinearSystem {
     };
     const int T = std::max(1, std::min(S, threads_ > 0 ? threads_ : static_cast<int>(std::thread::hardware_concurrency())));
     if (T == 1) {
-      for (int i = 0; i < S; ++i) work(i);
+      for (int i = 0; i < S; ++i) {
+        work(i);
+        if (on_segment_) on_segment_(i + 1, S);
+      }
     } else {
       // Stripe t of the segments on thread t; the calling thread takes stripe 0 and any stripe
       // whose thread could not be created (no thread is left unjoined, no exception escapes one).
       std::vector<std::exception_ptr> errors(T);
       auto stripe = [&](int t) {
         try {
-          for (int i = t; i < S; i += T) work(i);
+          for (int i = t; i < S; i += T) {
+            work(i);
+            if (t == 0 && on_segment_) on_segment_(i + 1, S);
+          }
         } catch (...) {
           errors[t] = std::current_exception();
         }
@@ -166,6 +174,12 @@ class ShootingSystem : public NonlinearSystem {
   }
 
   const std::string& last_failure() const { return last_failure_; }
+  // The largest roundoff floor of a row over the tolerance, as estimated by row_tolerances: above
+  // 1e4 the tolerance asks for digits the scheme cannot deliver on this grid.
+  double floor_ratio() const { return floor_ratio_; }
+  // Called on the calling thread as segments are propagated ("segment i of S"), for progress
+  // displays of long evaluations; may throw (e.g. to stop on an interrupt).
+  void set_on_segment(std::function<void(int, int)> f) { on_segment_ = std::move(f); }
   const std::vector<int>& starts() const { return starts_; }
   const typename A::BVP& bvp() const { return bvp_; }
   std::vector<std::string> row_names() const {
@@ -244,6 +258,8 @@ class ShootingSystem : public NonlinearSystem {
   typename A::Flow flow_;
   int threads_;
   std::string last_failure_;
+  double floor_ratio_ = 0;
+  std::function<void(int, int)> on_segment_;
   Eigen::MatrixXd M_, Minv_;
   Eigen::VectorXd w_;
   Eigen::VectorXd memo_x_, memo_F_;

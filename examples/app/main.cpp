@@ -40,7 +40,7 @@ Progress progress_printer(const Common& c) {
   auto last = std::make_shared<std::chrono::steady_clock::time_point>(std::chrono::steady_clock::now());
   return [show, every_line, last](const std::string& line) {
     throw_if_interrupted();
-    if (!show) return;
+    if (!show || line.empty()) return;  // an empty line is a checkpoint only
     const auto now = std::chrono::steady_clock::now();
     if (!every_line && now - *last < std::chrono::seconds(10)) return;
     *last = now;
@@ -79,9 +79,10 @@ void print_run(const RunRecord& r) {
   }
   std::printf("\nstatus: %s (%s)\n", r.status.c_str(), r.message.c_str());
   if (r.command == "solve")
-    std::printf("residual: %s x tolerance (raw %s), Jacobian condition %s, rank %d of %d\n",
+    std::printf("residual: %s x tolerance (raw %s), Jacobian condition %s, rank %s of %d\n",
                 fmt("%.3g", r.residual_norm).c_str(), fmt("%.3g", r.raw_residual_norm).c_str(),
-                fmt("%.3g", r.condition).c_str(), r.rank, r.unknowns);
+                fmt("%.3g", r.condition).c_str(), r.rank >= 0 ? std::to_string(r.rank).c_str() : "not computed",
+                r.unknowns);
   else
     std::printf("Newton: %d iterations over all steps, max step residual %s, max step condition %s\n", r.iterations,
                 fmt("%.3g", r.residual_norm).c_str(), fmt("%.3g", r.condition).c_str());

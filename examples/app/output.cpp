@@ -241,7 +241,7 @@ Written write_run(const Scene& scene, const RunRecord& r, OutputDir& out, bool p
     j["residual_history"] = json::array();
     for (double x : r.residual_history) j["residual_history"].push_back(finite_or_null(x));
     j["condition"] = finite_or_null(r.condition);
-    j["rank"] = r.rank;
+    j["rank"] = r.rank >= 0 ? json(r.rank) : json(nullptr);
     j["unknowns"] = r.unknowns;
     if (!r.dependent_conditions.empty()) j["dependent_conditions"] = r.dependent_conditions;
   } else {

@@ -47,7 +47,7 @@ struct RunRecord {
   double action = 0;      // Σ L_d over the windows (the cost, for optimal control)
   int iterations = 0;     // shooting iterations, or Newton iterations over all steps (simulate)
   double residual_norm = 0, raw_residual_norm = 0, condition = 0;
-  int rank = 0, unknowns = 0;
+  int rank = -1, unknowns = 0;  // rank -1: not computed
   std::vector<double> residual_history;
   std::vector<std::string> dependent_conditions;
   bool has_momentum = false;        // false when the symmetry group is trivial

@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <memory>
 
 namespace lpshoot::app {
 
@@ -36,15 +37,25 @@ inline void describe_solver(const Scene& s, RunRecord& r) {
   r.tolerance = s.shooting.solver.tolerance;
 }
 
-// Shooting options with a progress line per iteration.
+// Shooting options with a progress line per iteration, and within an evaluation that takes long
+// (large N: seconds to minutes) a line every 5 s naming the segments propagated; every segment
+// is an interrupt checkpoint (an empty line).
 inline ShootingOptions options_with_progress(const Scene& s, const Progress& progress) {
   ShootingOptions opt = s.shooting;
-  if (progress)
+  if (progress) {
     opt.solver.on_iteration = [progress](int it, double norm) {
       char buf[96];
       std::snprintf(buf, sizeof buf, "iteration %d: residual %.3g x tolerance", it, norm);
       progress(buf);
     };
+    auto last = std::make_shared<std::chrono::steady_clock::time_point>(std::chrono::steady_clock::now());
+    opt.on_segment = [progress, last](int done, int total) {
+      const auto now = std::chrono::steady_clock::now();
+      if (now - *last < std::chrono::seconds(5)) return progress(std::string());
+      *last = now;
+      progress("propagating: segment " + std::to_string(done) + " of " + std::to_string(total) + " done");
+    };
+  }
   return opt;
 }
 

@@ -252,6 +252,29 @@ TEST(FailedRuns, RoundoffFloorIsNamedAndAutomaticSegmentsAvoidIt) {
   EXPECT_NEAR(ok["final_state"]["x2"].get<double>(), 1.0, 1e-8);  // the terminal position is hit
 }
 
+TEST(FailedRuns, BelowTheNodalFloorTheGalerkinIncrementsConverge) {
+  // h = 1e-4 (issue 14): the nodal windows' floor (~u/h^3 in third differences) is far above the
+  // tolerance even on 100-step segments; the failure names it and the remedy, and the Galerkin
+  // scheme on the same grid (states in increments) converges and hits the terminal data.
+  const fs::path work = scratch("floor");
+  const std::string base = "solve '" + scene("electron") + "' --no-plot --set horizon.N=20000 --set solver.segments=auto ";
+  const Outcome o = run_cli(base + "--out '" + (work / "nodal").string() + "'", work);
+  EXPECT_EQ(o.code, 1) << o.out;
+  const json failed = json::parse(std::ifstream(work / "nodal" / "report.json"));
+  EXPECT_EQ(failed["status"], "not_converged");
+  const std::string why = failed["message"];
+  EXPECT_NE(why.find("below the roundoff floor"), std::string::npos) << why;
+  EXPECT_NE(why.find("Galerkin"), std::string::npos) << why;
+  const Outcome g = run_cli(base + "--set 'scheme={\"discretization\": \"galerkin\", \"order\": 4}' --out '" +
+                                (work / "galerkin").string() + "'",
+                            work);
+  ASSERT_EQ(g.code, 0) << g.out << g.err;
+  const json ok = json::parse(std::ifstream(work / "galerkin" / "report.json"));
+  EXPECT_EQ(ok["status"], "converged");
+  EXPECT_NEAR(ok["final_state"]["x2"].get<double>(), 1.0, 1e-9);
+  EXPECT_NEAR(ok["final_state"]["v3"].get<double>(), 0.2, 1e-9);
+}
+
 TEST(Continuation, StiffPotentialIsReachedFromTheFreeProblem) {
   // V = 100 (1 - cos ψ): multiple shooting from the interpolated guess diverges; continuation in
   // the amplitude from 0 reaches it. Oracle: single shooting converges here directly, and both

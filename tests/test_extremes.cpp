@@ -1,0 +1,91 @@
+// Extremes (issue 14): Galerkin steps at tiny h, where each step's Newton correction cannot get
+// below its rounding; rank diagnostics of Jacobians from an overflowing flow.
+#include <lpshoot/problems/beanie_bvp.hpp>
+#include <lpshoot/shooting/diagnostics.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+using namespace lpshoot;
+using namespace lpshoot::problems;
+
+namespace {
+
+// The first interval of the guess of a well-posed beanie problem on N intervals over T, with
+// small non-zero bubbles and multipliers.
+template <int S>
+Interval<BeanieGalerkin<S>, double> first_interval(const BeanieModel& model, double T, int N) {
+  BeanieBoundary s, e;
+  s.psi = 0.2, s.psi_dot = 0.4, s.theta = 0.1, s.x = 0, s.y = 0, s.Omega1 = 0.5, s.Omega2 = 0.2;
+  e.psi = 1, e.psi_dot = 0, e.theta = 1;
+  const auto bvp = beanie_galerkin_bvp<S>(model, T, N, s, e);
+  Interval<BeanieGalerkin<S>, double> iv = beanie_galerkin_guess<S>(bvp, s, e).trajectory.intervals[0];
+  for (int i = 0; i < BeanieGalerkin<S>::aux; ++i) iv.w(i) = 0.01 * std::sin(1.0 + i);
+  return iv;
+}
+
+// 300 steps at h = 2/N with the default step tolerance (1e-12, below what a step can resolve at
+// these h: terms of size 1/h cancel in its equations). Each step must be accepted at its rounding
+// and still solve its equations: the momentum map (conserved exactly by solutions of the step
+// equations, METHOD.md §4) drifts only by rounding: measured at most 1.2e-11 relative here. The
+// bound, 1e-10, is far below what a wrongly accepted step would leave: the stagnation rule may
+// accept corrections of up to 1e-8 relative, and a step stopped there drifts J by about that.
+template <int S>
+void tiny_steps(int N) {
+  BeanieModel model;
+  model.par = {1.0, 1.0, 0.5, 1.0};
+  const double T = 2.0, h = T / N;
+  const int steps = 300;
+  const SE2::Element<double> g0{0.3, Eigen::Vector2d(0.5, -0.2)};
+  const auto run = GalerkinFlow<BeanieGalerkin<S>>(model, h, NewtonOptions{}).run(first_interval<S>(model, T, N), steps,
+                                                                                   nullptr, g0);
+  ASSERT_TRUE(run.report.ok()) << "h = " << h << ": " << run.report.message;
+  const auto J = galerkin_spatial_momentum<BeanieGalerkin<S>>(model, run.trajectory);
+  double drift = 0, lam = 0;
+  for (const auto& Jn : J) drift = std::max(drift, (Jn - J.front()).template lpNorm<Eigen::Infinity>());
+  for (const auto& iv : run.trajectory.intervals) lam = std::max(lam, iv.w.template lpNorm<Eigen::Infinity>());
+  const double relative = drift / std::max(1.0, J.front().template lpNorm<Eigen::Infinity>());
+  const double bound = 1e-10;
+  std::printf("degree %d, h = %.0e: %d steps, max Newton iterations %d, max step condition %.2e, max |lambda| %.2g, relative "
+              "momentum drift %.2e\n",
+              S, h, steps, run.report.max_iterations, run.report.max_condition, lam, relative);
+  EXPECT_LT(relative, bound);
+}
+
+}  // namespace
+
+TEST(TinySteps, GalerkinOrderFourStepsConvergeDownToHEqualsOneMillionth) {
+  for (int N : {20000, 200000, 2000000}) tiny_steps<3>(N);
+}
+
+TEST(TinySteps, GalerkinOrderSixStepsConvergeDownToHEqualsOneMillionth) {
+  for (int N : {20000, 200000, 2000000}) tiny_steps<4>(N);
+}
+
+TEST(RankDiagnosis, ANonFiniteJacobianHasNoRank) {
+  Eigen::MatrixXd J = Eigen::MatrixXd::Identity(4, 4);
+  J(2, 1) = INFINITY;
+  const RankDiagnosis d = diagnose_rank(J, {"a", "b", "c", "d"}, 1e-10);
+  EXPECT_EQ(d.rank, -1);
+  EXPECT_FALSE(std::isfinite(d.condition));
+}
+
+TEST(RankDiagnosis, SubnormalRoundingDoesNotHideADependentRow) {
+  // Rows 0 and 3 are equal up to entries far below rounding (subnormal after equilibration):
+  // rank 39 of 40, and the dependent pair is named.
+  const int n = 40;
+  Eigen::MatrixXd J = Eigen::MatrixXd::Random(n, n);
+  J.row(n - 1) = J.row(0);
+  for (int c = 0; c < n; c += 3) J(n - 1, c) += 1e-310;
+  J.row(5) *= 1e250;
+  std::vector<std::string> names;
+  for (int i = 0; i < n; ++i) names.push_back("row " + std::to_string(i));
+  const RankDiagnosis d = diagnose_rank(J, names, 1e-10);
+  EXPECT_EQ(d.rank, n - 1);
+  ASSERT_EQ(d.dependent_conditions.size(), 1u);
+  EXPECT_NE(d.dependent_conditions[0].find("[row 0]"), std::string::npos) << d.dependent_conditions[0];
+  EXPECT_NE(d.dependent_conditions[0].find("[row 39]"), std::string::npos) << d.dependent_conditions[0];
+}
