@@ -78,7 +78,7 @@ struct Scene {
   // states each step and amplifies that like L^4 eps over L steps (METHOD.md §5); 100 steps keep
   // it near 1e-8 of the state's size, and the segment count grows only with N. (Galerkin states
   // do not amplify roundoff that way; 100 steps still bound the growth of unstable flows.)
-  int default_segments(int n) const { return std::clamp((n + 99) / 100, 1, max_segments(n)); }
+  int default_segments(int n) const { return std::clamp(n / 100 + (n % 100 != 0), 1, max_segments(n)); }
   // "paper", "galerkin4" or "galerkin6": the names `sweep --scheme` takes.
   std::string scheme_name() const { return galerkin() ? "galerkin" + std::to_string(galerkin_order) : "paper"; }
 };

@@ -36,6 +36,9 @@ endif()
 if(CXX_COMPILER_LAUNCHER)
   list(APPEND configure_args "-DCMAKE_CXX_COMPILER_LAUNCHER=${CXX_COMPILER_LAUNCHER}")
 endif()
+if(SANITIZE)  # a checked build's libraries are instrumented: the example must link the runtimes
+  list(APPEND configure_args "-DCMAKE_CXX_FLAGS=-fsanitize=${SANITIZE}" "-DCMAKE_EXE_LINKER_FLAGS=-fsanitize=${SANITIZE}")
+endif()
 step("configure the example" ${CMAKE_COMMAND} ${configure_args})
 step("build the example" ${CMAKE_COMMAND} --build "${example_build}" --config Release)
 
