@@ -1,5 +1,7 @@
 // Extremes (issue 14): Galerkin steps at tiny h, where each step's Newton correction cannot get
 // below its rounding; rank diagnostics of Jacobians from an overflowing flow.
+#include "beanie_galerkin_start.hpp"
+
 #include <lpshoot/problems/beanie_bvp.hpp>
 #include <lpshoot/shooting/diagnostics.hpp>
 
@@ -14,19 +16,6 @@ using namespace lpshoot::problems;
 
 namespace {
 
-// The first interval of the guess of a well-posed beanie problem on N intervals over T, with
-// small non-zero bubbles and multipliers.
-template <int S>
-Interval<BeanieGalerkin<S>, double> first_interval(const BeanieModel& model, double T, int N) {
-  BeanieBoundary s, e;
-  s.psi = 0.2, s.psi_dot = 0.4, s.theta = 0.1, s.x = 0, s.y = 0, s.Omega1 = 0.5, s.Omega2 = 0.2;
-  e.psi = 1, e.psi_dot = 0, e.theta = 1;
-  const auto bvp = beanie_galerkin_bvp<S>(model, T, N, s, e);
-  Interval<BeanieGalerkin<S>, double> iv = beanie_galerkin_guess<S>(bvp, s, e).trajectory.intervals[0];
-  for (int i = 0; i < BeanieGalerkin<S>::aux; ++i) iv.w(i) = 0.01 * std::sin(1.0 + i);
-  return iv;
-}
-
 // 300 steps at h = 2/N with the default step tolerance (1e-12, below what a step can resolve at
 // these h: terms of size 1/h cancel in its equations). Each step must be accepted at its rounding
 // and still solve its equations: the momentum map (conserved exactly by solutions of the step
@@ -40,8 +29,8 @@ void tiny_steps(int N) {
   const double T = 2.0, h = T / N;
   const int steps = 300;
   const SE2::Element<double> g0{0.3, Eigen::Vector2d(0.5, -0.2)};
-  const auto run = GalerkinFlow<BeanieGalerkin<S>>(model, h, NewtonOptions{}).run(first_interval<S>(model, T, N), steps,
-                                                                                   nullptr, g0);
+  const auto start = test_support::beanie_interval_with_multipliers<S>(model, T, N);
+  const auto run = GalerkinFlow<BeanieGalerkin<S>>(model, h, NewtonOptions{}).run(start, steps, nullptr, g0);
   ASSERT_TRUE(run.report.ok()) << "h = " << h << ": " << run.report.message;
   const auto J = galerkin_spatial_momentum<BeanieGalerkin<S>>(model, run.trajectory);
   double drift = 0, lam = 0;

@@ -1,6 +1,7 @@
 // The Galerkin schemes (METHOD.md §9): observed orders against exact and independent continuous
 // references, the discrete momentum map, the flow's sensitivities, the regularity check, the
 // shooting Jacobian, and no roundoff floor on fine grids.
+#include "beanie_galerkin_start.hpp"
 #include "oracles/continuous.hpp"
 
 #include <lpshoot/problems/beanie_bvp.hpp>
@@ -177,18 +178,7 @@ TEST(GalerkinBeanie, CubicIsOrderFourInEveryOutput) {
 
 namespace {
 using BG = BeanieGalerkin<3>;
-
-// A beanie Galerkin interval with non-zero multipliers (from the guess of a well-posed problem).
-template <int S = 3>
-Interval<BeanieGalerkin<S>, double> beanie_interval_with_multipliers(const BeanieModel& model, double T, int N) {
-  BeanieBoundary s, e;
-  s.psi = 0.2, s.psi_dot = 0.4, s.theta = 0.1, s.x = 0, s.y = 0, s.Omega1 = 0.5, s.Omega2 = 0.2;
-  e.psi = 1, e.psi_dot = 0, e.theta = 1;
-  const auto bvp = beanie_galerkin_bvp<S>(model, T, N, s, e);
-  Interval<BeanieGalerkin<S>, double> iv = beanie_galerkin_guess<S>(bvp, s, e).trajectory.intervals[0];
-  for (int i = 0; i < BeanieGalerkin<S>::aux; ++i) iv.w(i) = 0.01 * std::sin(1.0 + i);  // bubbles and multipliers
-  return iv;
-}
+using test_support::beanie_interval_with_multipliers;
 }  // namespace
 
 TEST(GalerkinBeanie, MomentumIsConservedToRoundoffWithNonZeroMultipliers) {
