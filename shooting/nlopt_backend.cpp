@@ -1,6 +1,8 @@
 // NLopt backend: SLSQP with F(x) = 0 as equality constraints and a zero objective, so that each
 // SQP step is the minimum-norm Newton step of the square system. Exceptions thrown in a callback
-// come back from NLopt as a generic failure: they are stored and rethrown.
+// come back from NLopt as a generic failure: they are stored and rethrown. SLSQP is a dense
+// method (its quasi-Newton matrix is n x n): the sparse Jacobian is expanded here, so this
+// backend suits systems of up to a few thousand unknowns; KINSOL's is the structured one.
 #include "nonlinear_solver.hpp"
 
 #include <nlopt.hpp>
@@ -14,7 +16,7 @@ namespace {
 struct NloptData {
   NonlinearSystem* system;
   Eigen::VectorXd x, F;
-  Eigen::MatrixXd J;
+  SparseJacobian J;
   std::exception_ptr error;
   int evaluations = 0, jacobians = 0;
   bool failed = false;
@@ -38,7 +40,7 @@ void constraints(unsigned m, double* result, unsigned n, const double* x, double
         throw nlopt::forced_stop();
       }
       // NLopt wants grad[i * n + j] = dF_i / dx_j (row major).
-      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(grad, m, n) = d->J;
+      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(grad, m, n) = Eigen::MatrixXd(d->J);
       const double norm = d->F.lpNorm<Eigen::Infinity>();
       if (++d->jacobians > 1) d->history->push_back(norm);  // the start is recorded before optimize
       if (d->options->on_iteration) d->options->on_iteration(d->jacobians, norm);
@@ -60,7 +62,7 @@ double zero_objective(unsigned n, const double*, double* grad, void*) {
 SolverOutcome solve_nlopt(NonlinearSystem& system, Eigen::VectorXd& x, const SolverOptions& opt) {
   SolverOutcome out;
   const int n = system.size();
-  NloptData data{&system, x, Eigen::VectorXd(n), Eigen::MatrixXd(n, n), nullptr};
+  NloptData data{&system, x, Eigen::VectorXd(n), SparseJacobian(n, n), nullptr};
   data.options = &opt;
   data.history = &out.residual_history;
   nlopt::opt o(nlopt::LD_SLSQP, n);

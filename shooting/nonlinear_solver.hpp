@@ -1,9 +1,12 @@
 // A square nonlinear system F(x) = 0 with an exact Jacobian, and the solver backends behind one
 // interface: SUNDIALS KINSOL (Newton with line search, fresh Jacobian every iteration) and NLopt
 // (SLSQP with the equations as equality constraints). The C libraries stay in the .cpp files.
+// Jacobians are sparse (a shooting Jacobian is block bidiagonal): KINSOL factors them with
+// KLU, so that memory and work grow like the number of segments, not its square or cube.
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 
 #include <functional>
 #include <string>
@@ -11,13 +14,18 @@
 
 namespace lpshoot {
 
+// Column major: the layout of KLU's compressed sparse columns.
+using SparseJacobian = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+
 class NonlinearSystem {
  public:
   virtual ~NonlinearSystem() = default;
   virtual int size() const = 0;
   // Returns false when F cannot be evaluated at x (the flow failed): solvers then shorten the step.
   virtual bool residual(const Eigen::VectorXd& x, Eigen::VectorXd& F) = 0;
-  virtual bool jacobian(const Eigen::VectorXd& x, Eigen::MatrixXd& J) = 0;
+  // The pattern should not change between calls (explicit zeros are fine): KINSOL's KLU
+  // reuses its symbolic analysis, and analyses again when the pattern changes.
+  virtual bool jacobian(const Eigen::VectorXd& x, SparseJacobian& J) = 0;
   // The norm that judges progress (divergence) of full Newton steps, as opposed to convergence:
   // a system whose rows are scaled for the stopping test (e.g. by per-row tolerances) returns
   // the norm of the unscaled rows here.

@@ -24,9 +24,15 @@ enum class ShootingMethod { Single, Multiple };
 // flow is unstable or the guess is a near solution, e.g. a resampled one).
 enum class SegmentStarts { Guess, Propagated, Auto };
 
+// Multiple shooting's segment count for "auto" (the application's default too): segments of at
+// most 100 steps. A nodal recursion amplifies its rounding like L^4 eps over L steps (METHOD.md
+// §5): 100 steps keep that near 1e-8 of the state's size; unstable flows stay bounded over a
+// segment; the structured linear algebra makes the count's cost linear.
+inline int auto_segments(int steps) { return std::max(1, steps / 100 + (steps % 100 != 0)); }
+
 struct ShootingOptions {
   ShootingMethod method = ShootingMethod::Single;
-  int segments = 4;  // multiple shooting
+  int segments = 0;  // multiple shooting; 0: auto_segments(N)
   SegmentStarts segment_starts = SegmentStarts::Auto;
   SolverOptions solver;
   NewtonOptions step;
@@ -105,9 +111,10 @@ ShootingResult<X> solve_from_starts(const typename SchemeFor<X>::BVP& bvp,
   out.unknowns = system.size();
 
   Eigen::VectorXd x = Eigen::VectorXd::Zero(system.size());
-  {  // The guess must be evaluable.
-    Eigen::VectorXd F0;
-    if (!system.residual(x, F0))
+  {  // The guess must be evaluable. With its Jacobian: the row tolerances and the solver's first
+     // iteration use this evaluation (kept by the system), no other is made at the guess.
+    SparseJacobian J0;
+    if (!system.jacobian(x, J0))
       return finish(ShootingStatus::FlowFailed, "the discrete flow failed from the initial guess: " + system.last_failure());
   }
   // Rows scaled by 1/(their tolerance): the solver then stops at a max-norm of 1.
@@ -119,11 +126,10 @@ ShootingResult<X> solve_from_starts(const typename SchemeFor<X>::BVP& bvp,
   out.residual_history = so.residual_history;
   out.residual_norm = so.residual_norm;
 
-  // The trajectory at the final iterate.
+  // The trajectory at the final iterate (from the solver's last evaluation, which was there).
   std::vector<typename A::Run> runs;
   std::vector<typename A::State> st;
-  std::vector<Eigen::MatrixXd> Jr;
-  if (!system.propagate(x, false, runs, st, Jr))
+  if (!system.runs_at(x, runs, st))
     return finish(ShootingStatus::FlowFailed, "the discrete flow failed at the final iterate: " + system.last_failure());
   A::assemble(bvp, runs, st[0], out);
   {
@@ -131,9 +137,14 @@ ShootingResult<X> solve_from_starts(const typename SchemeFor<X>::BVP& bvp,
     out.raw_residual_norm = system.raw_residual(x, F) ? F.lpNorm<Eigen::Infinity>() : INFINITY;
   }
 
-  // Conditioning and rank of the shooting Jacobian at the final iterate.
-  Eigen::MatrixXd J;
-  if (system.jacobian(x, J)) {
+  // Conditioning and rank of the shooting Jacobian (structured: sparse QR and LU). At a converged
+  // solution, the last Newton iteration's Jacobian, one step away, serves: its rank and condition
+  // are the solution's; otherwise the Jacobian at the final iterate.
+  SparseJacobian J;
+  const bool have_J = so.status == SolverStatus::Converged && system.last_jacobian().rows() == system.size()
+                          ? (J = system.last_jacobian(), true)
+                          : system.jacobian(x, J);
+  if (have_J) {
     RankDiagnosis diag = diagnose_rank(std::move(J), system.row_names(), opt.rank_tolerance);
     out.rank = diag.rank;
     out.condition = diag.condition;
@@ -215,7 +226,8 @@ ShootingResult<X> solve_bvp_with(const typename SchemeFor<X>::BVP& bvp, const ty
   }
   // Segment starts (state indices) and reference states from the guess.
   const int first = A::first_state(bvp), last = A::last_state(bvp);
-  const int S = opt.method == ShootingMethod::Single ? 1 : std::max(1, std::min(opt.segments, last - first));
+  const int wanted = opt.segments > 0 ? opt.segments : auto_segments(bvp.N);
+  const int S = opt.method == ShootingMethod::Single ? 1 : std::max(1, std::min(wanted, last - first));
   std::vector<int> starts;
   for (int i = 0; i <= S; ++i) starts.push_back(first + static_cast<int>(std::lround(double(last - first) * i / S)));
   const auto refs = A::states(bvp, guess, std::vector<int>(starts.begin(), starts.end() - 1));

@@ -6,8 +6,9 @@
 // rows (the first state's own equations and the initial conditions), the continuity defects
 // M (end of segment i ⊖ start of segment i+1) (group parts in the tangent space), the terminal
 // conditions on the last segment's end. The Jacobian is exact: flow sensitivities (implicit
-// function theorem) times automatic derivatives of the conditions; it is block bidiagonal and
-// the segments are propagated in parallel.
+// function theorem) times automatic derivatives of the conditions; it is block bidiagonal, kept
+// sparse (n x n blocks: memory linear in the number of segments), and the segments are
+// propagated in parallel.
 #pragma once
 
 #include "nonlinear_solver.hpp"
@@ -15,6 +16,7 @@
 #include "scheme_nodal.hpp"
 
 #include <Eigen/LU>
+#include <Eigen/SparseCore>
 
 #include <algorithm>
 #include <limits>
@@ -67,12 +69,19 @@ class ShootingSystem : public NonlinearSystem {
     if (w_.size() == F.size()) F.array() *= w_.array();
     return true;
   }
-  bool jacobian(const Eigen::VectorXd& x, Eigen::MatrixXd& J) override {
+  bool jacobian(const Eigen::VectorXd& x, SparseJacobian& J) override {
     Eigen::VectorXd F;
     if (!evaluate(x, F, &J)) return false;
-    if (w_.size() == J.rows()) J = w_.asDiagonal() * J;
+    if (w_.size() == J.rows())
+      for (int c = 0; c < J.outerSize(); ++c)
+        for (SparseJacobian::InnerIterator it(J, c); it; ++it) it.valueRef() *= w_(it.row());
     return true;
   }
+  // The unscaled Jacobian of the last evaluation that computed one, and where: at convergence,
+  // the last Newton iterate's, one step from the solution (for diagnostics that need no exact
+  // point: the rank and condition there are those of the solution to the digits reported).
+  const SparseJacobian& last_jacobian() const { return last_J_; }
+  const Eigen::VectorXd& last_jacobian_point() const { return last_J_x_; }
   void set_row_scaling(const Eigen::VectorXd& w) { w_ = w; }
   double progress_norm(const Eigen::VectorXd& F) const override {
     return w_.size() == F.size() ? F.cwiseQuotient(w_).lpNorm<Eigen::Infinity>() : F.lpNorm<Eigen::Infinity>();
@@ -87,7 +96,7 @@ class ShootingSystem : public NonlinearSystem {
   Eigen::VectorXd row_tolerances(const Eigen::VectorXd& x, double tol) {
     const int S = segments();
     Eigen::VectorXd F;
-    Eigen::MatrixXd J;
+    SparseJacobian J;
     const Eigen::VectorXd w = w_;
     w_.resize(0);
     const bool ok = evaluate(x, F, &J);
@@ -96,8 +105,15 @@ class ShootingSystem : public NonlinearSystem {
     if (!ok) return t;
     Eigen::VectorXd mag(size());
     for (int i = 0; i < S; ++i) mag.segment(i * n, n) = A::magnitudes(bvp_, refs_[i]);
-    Eigen::MatrixXd Jd = J;  // J_x M = J_δ, per segment block of columns
-    for (int i = 0; i < S; ++i) Jd.middleCols(i * n, n) = J.middleCols(i * n, n) * M_;
+    // J_δ = J_x diag(M, ..., M): each segment's block of columns times M.
+    std::vector<Eigen::Triplet<double, int>> blocks;
+    blocks.reserve(static_cast<size_t>(S) * n * n);
+    for (int i = 0; i < S; ++i)
+      for (int c = 0; c < n; ++c)
+        for (int r = 0; r < n; ++r) blocks.emplace_back(i * n + r, i * n + c, M_(r, c));
+    SparseJacobian Mb(size(), size());
+    Mb.setFromTriplets(blocks.begin(), blocks.end());
+    const SparseJacobian Jd = J * Mb;
     constexpr double u = std::numeric_limits<double>::epsilon();
     const Eigen::ArrayXd floor = A::roundoff_factor * u * (Jd.cwiseAbs() * mag).array();
     t.array() += floor.min(1e4 * tol);  // at most four digits conceded to roundoff: beyond, not converged
@@ -113,6 +129,17 @@ class ShootingSystem : public NonlinearSystem {
 
   // The conditions in their own units (no row scaling).
   bool raw_residual(const Eigen::VectorXd& x, Eigen::VectorXd& F) { return evaluate(x, F, nullptr); }
+
+  // The segment runs at x: those of the last evaluation when it was at x, else propagated anew.
+  bool runs_at(const Eigen::VectorXd& x, std::vector<typename A::Run>& runs, std::vector<State>& starts) {
+    if (memo_ok_ && memo_x_.size() == x.size() && memo_x_ == x && !memo_runs_.empty()) {
+      runs = memo_runs_;
+      starts = memo_starts_;
+      return true;
+    }
+    std::vector<Eigen::MatrixXd> Jr;
+    return propagate(x, false, runs, starts, Jr);
+  }
 
   // Runs all segments at x; fills the per-segment results. False if a flow failed.
   bool propagate(const Eigen::VectorXd& x, bool sensitivities, std::vector<typename A::Run>& runs,
@@ -200,12 +227,12 @@ class ShootingSystem : public NonlinearSystem {
  private:
   // The conditions (unscaled) at x, with their Jacobian when J is given. The last evaluation is
   // kept: the solver asks again for what the setup (row tolerances) already computed at the guess.
-  bool evaluate(const Eigen::VectorXd& x, Eigen::VectorXd& F, Eigen::MatrixXd* J) {
+  bool evaluate(const Eigen::VectorXd& x, Eigen::VectorXd& F, SparseJacobian* J) {
     const bool same_x = memo_x_.size() == x.size() && memo_x_ == x;
     if (same_x && (!J || memo_has_J_)) {
       if (!memo_ok_) return false;
       F = memo_F_;
-      if (J) *J = memo_J_;
+      if (J) *J = last_J_;
       return true;
     }
     memo_x_ = x;
@@ -213,25 +240,38 @@ class ShootingSystem : public NonlinearSystem {
     memo_ok_ = evaluate_uncached(x, F, J);
     if (memo_ok_) {
       memo_F_ = F;
-      if (J) memo_J_ = *J;
+      if (J) {
+        last_J_ = *J;
+        last_J_x_ = x;
+      }
     }
     return memo_ok_;
   }
 
-  bool evaluate_uncached(const Eigen::VectorXd& x, Eigen::VectorXd& F, Eigen::MatrixXd* J) {
-    std::vector<typename A::Run> runs;
-    std::vector<State> starts;
+  bool evaluate_uncached(const Eigen::VectorXd& x, Eigen::VectorXd& F, SparseJacobian* J) {
+    std::vector<typename A::Run>& runs = memo_runs_;
+    std::vector<State>& starts = memo_starts_;
     std::vector<Eigen::MatrixXd> Jr;
-    if (!propagate(x, J != nullptr, runs, starts, Jr)) return false;
+    if (!propagate(x, J != nullptr, runs, starts, Jr)) {
+      runs.clear();
+      return false;
+    }
     const int S = segments(), N = size();
     F.resize(N);
-    if (J) J->setZero(N, N);
+    // The Jacobian's n x n blocks, every entry stored (zeros too): its pattern stays the same
+    // from one evaluation to the next, so the sparse factorization's analysis is reused.
+    std::vector<Eigen::Triplet<double, int>> entries;
+    if (J) entries.reserve(static_cast<size_t>(2 * S + 1) * n * n);
+    auto put = [&](int row, int col, const Eigen::MatrixXd& B) {
+      for (int c = 0; c < B.cols(); ++c)
+        for (int r = 0; r < B.rows(); ++r) entries.emplace_back(row + r, col + c, B(r, c));
+    };
     int row = 0;
     Eigen::VectorXd R;
     Eigen::MatrixXd JB;
     A::boundary_block(bvp_, End::Initial, starts[0], R, J ? &JB : nullptr);
     F.segment(row, R.size()) = R;
-    if (J) J->block(row, 0, R.size(), n) = JB * Jr[0];
+    if (J) put(row, 0, JB * Jr[0]);
     row += R.size();
     for (int i = 0; i + 1 < S; ++i) {  // continuity: end of segment i minus start of segment i+1
       const State e = A::end_state(runs[i]);
@@ -239,16 +279,21 @@ class ShootingSystem : public NonlinearSystem {
       if (J) {
         Eigen::MatrixXd De, Ds;
         A::difference_jacobians(bvp_, e, starts[i + 1], De, Ds);
-        J->block(row, i * n, n, n) = M_ * De * runs[i].sensitivity;
-        J->block(row, (i + 1) * n, n, n) = M_ * Ds * Jr[i + 1];
+        put(row, i * n, M_ * De * runs[i].sensitivity);
+        put(row, (i + 1) * n, M_ * Ds * Jr[i + 1]);
       }
       row += n;
     }
     const State e = A::end_state(runs[S - 1]);
     A::boundary_block(bvp_, End::Terminal, e, R, J ? &JB : nullptr);
     F.segment(row, R.size()) = R;
-    if (J) J->block(row, (S - 1) * n, R.size(), n) = JB * runs[S - 1].sensitivity;
+    if (J) put(row, (S - 1) * n, JB * runs[S - 1].sensitivity);
     row += R.size();
+    if (J) {
+      J->resize(N, N);
+      J->setFromTriplets(entries.begin(), entries.end());
+      J->makeCompressed();
+    }
     return row == N;
   }
 
@@ -263,7 +308,10 @@ class ShootingSystem : public NonlinearSystem {
   Eigen::MatrixXd M_, Minv_;
   Eigen::VectorXd w_;
   Eigen::VectorXd memo_x_, memo_F_;
-  Eigen::MatrixXd memo_J_;
+  std::vector<typename A::Run> memo_runs_;
+  std::vector<State> memo_starts_;
+  SparseJacobian last_J_;
+  Eigen::VectorXd last_J_x_;
   bool memo_has_J_ = false, memo_ok_ = false;
 };
 

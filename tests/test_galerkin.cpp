@@ -292,8 +292,9 @@ TEST(GalerkinShooting, JacobianMatchesFiniteDifferences) {
     std::normal_distribution<double> n01;
     Eigen::VectorXd x(sys.size());
     for (int i = 0; i < x.size(); ++i) x(i) = 1e-3 * n01(rng);
-    Eigen::MatrixXd J;
-    ASSERT_TRUE(sys.jacobian(x, J));
+    SparseJacobian Js;
+    ASSERT_TRUE(sys.jacobian(x, Js));
+    const Eigen::MatrixXd J(Js);
     // Richardson-extrapolated central differences (truncation O(eps^4), noise ~1e-13/eps).
     double worst = 0;
     const double eps = 1e-5;

@@ -19,8 +19,8 @@ struct Atan : NonlinearSystem {
     F = (x - a).array().atan().matrix();
     return true;
   }
-  bool jacobian(const Eigen::VectorXd& x, Eigen::MatrixXd& J) override {
-    J = (1.0 / (1.0 + (x - a).array().square())).matrix().asDiagonal();
+  bool jacobian(const Eigen::VectorXd& x, SparseJacobian& J) override {
+    J = Eigen::MatrixXd((1.0 / (1.0 + (x - a).array().square())).matrix().asDiagonal()).sparseView();
     return true;
   }
 };
@@ -35,8 +35,8 @@ struct Noisy : NonlinearSystem {
     F = x + 1e-7 * Eigen::Vector2d(std::sin(12.9898 * calls), std::cos(78.233 * calls));
     return true;
   }
-  bool jacobian(const Eigen::VectorXd&, Eigen::MatrixXd& J) override {
-    J = Eigen::MatrixXd::Identity(2, 2);
+  bool jacobian(const Eigen::VectorXd&, SparseJacobian& J) override {
+    J = Eigen::MatrixXd::Identity(2, 2).sparseView();
     return true;
   }
 };

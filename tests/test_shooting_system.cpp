@@ -33,8 +33,9 @@ TEST(ShootingSystem, JacobianMatchesFiniteDifferencesWithGroupsAndSegments) {
     std::normal_distribution<double> n01;
     Eigen::VectorXd x(sys.size());
     for (int i = 0; i < x.size(); ++i) x(i) = 1e-3 * n01(rng);
-    Eigen::MatrixXd J;
-    ASSERT_TRUE(sys.jacobian(x, J));
+    SparseJacobian Js;
+    ASSERT_TRUE(sys.jacobian(x, Js));
+    const Eigen::MatrixXd J(Js);
     // Richardson-extrapolated central differences (error O(eps^4)) at two step sizes: either they
     // already agree with J to 1e-6 (the noise floor: the flow's Newton tolerance, ~1e-12/eps), or their error shrinks like eps^4 towards J. A wrong J would
     // leave an error that does not shrink. (The third-difference directions of the unknowns have
@@ -112,8 +113,9 @@ TEST(ShootingSystem, LinearProblemJacobianStaysExactOnFineGrids) {
     detail::ShootingSystem<Electron> sys(bvp, refs, starts, NewtonOptions{}, 1);
     const Eigen::VectorXd x = Eigen::VectorXd::Zero(sys.size());
     Eigen::VectorXd F, Fj;
-    Eigen::MatrixXd J;
-    ASSERT_TRUE(sys.residual(x, F) && sys.jacobian(x, J));
+    SparseJacobian Js;
+    ASSERT_TRUE(sys.residual(x, F) && sys.jacobian(x, Js));
+    const Eigen::MatrixXd J(Js);
     double worst = 0;
     for (int j = 0; j < sys.size(); ++j) {
       Eigen::VectorXd xj = x;

@@ -74,11 +74,9 @@ struct Scene {
   int min_N() const { return galerkin() ? 2 : 2 * order() + 1; }
   // Multiple shooting's segment count: at most N - 2k + 1 (paper) or N (Galerkin).
   int max_segments(int n) const { return galerkin() ? n : n - 2 * order() + 1; }
-  // solver.segments "auto": segments of at most 100 steps. A k = 2 recursion rounds its nodal
-  // states each step and amplifies that like L^4 eps over L steps (METHOD.md §5); 100 steps keep
-  // it near 1e-8 of the state's size, and the segment count grows only with N. (Galerkin states
-  // do not amplify roundoff that way; 100 steps still bound the growth of unstable flows.)
-  int default_segments(int n) const { return std::clamp(n / 100 + (n % 100 != 0), 1, max_segments(n)); }
+  // solver.segments "auto": the library's choice, lpshoot::auto_segments (segments of at most
+  // 100 steps), within this scheme's limit.
+  int default_segments(int n) const { return std::clamp(lpshoot::auto_segments(n), 1, max_segments(n)); }
   // "paper", "galerkin4" or "galerkin6": the names `sweep --scheme` takes.
   std::string scheme_name() const { return galerkin() ? "galerkin" + std::to_string(galerkin_order) : "paper"; }
 };

@@ -1,0 +1,106 @@
+// Solve time against N (issue 9): multiple shooting with segments "auto" (100 steps each) and
+// the structured linear algebra, from N = 10^3 to 10^5, one and two threads. The electron on the
+// cubic Galerkin scheme (order 4, no roundoff floor: converges at tolerance 1e-10 at every N),
+// the electron (N <= 10^4) and the beanie (N <= 4000) on the paper's windows (second-order
+// closure) at tolerance 1e-6: finer grids fall below the nodal scheme's roundoff floor (~u/h^3).
+// Counters: converged, iterations, unknowns, and the peak resident memory of the process so far
+// (getrusage; a high-water mark, so read it on the largest N of a run).
+//   ./build/bench/bench_scaling --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
+#include <lpshoot/problems/beanie_bvp.hpp>
+#include <lpshoot/problems/electron_bvp.hpp>
+
+#include <benchmark/benchmark.h>
+
+#include <sys/resource.h>
+
+#include <string>
+
+using namespace lpshoot;
+using namespace lpshoot::problems;
+
+namespace {
+constexpr double kT = 2.0;
+const ElectronBoundary kStart{Eigen::Vector3d(1.0, 0.0, 0.5), Eigen::Vector3d(0.0, 1.0, 0.0)};
+const ElectronBoundary kEnd{Eigen::Vector3d(0.0, 1.0, -0.5), Eigen::Vector3d(-1.0, 0.0, 0.2)};
+
+ShootingOptions options(int threads, double tolerance) {
+  ShootingOptions opt;
+  opt.method = ShootingMethod::Multiple;  // segments: auto
+  opt.threads = threads;
+  opt.solver.tolerance = tolerance;
+  return opt;
+}
+
+double peak_rss_mb() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_maxrss / 1024.0;
+}
+
+template <class R>
+void report(benchmark::State& state, const R& r) {
+  state.counters["converged"] = r.ok() ? 1 : 0;
+  state.counters["iterations"] = r.iterations;
+  state.counters["unknowns"] = r.unknowns;
+  state.counters["peak_MB"] = peak_rss_mb();
+  if (!r.ok()) state.SetLabel(std::string(status_name(r.status)) + ": " + r.message);
+}
+
+void electron_galerkin(benchmark::State& state) {
+  const int N = static_cast<int>(state.range(0));
+  const auto bvp = electron_galerkin_bvp<3>(model_of(Electron{}), kT, N, kStart, kEnd);
+  const auto guess = electron_galerkin_guess<3>(bvp, kStart, kEnd);
+  ShootingResult<Galerkin<ElectronModel, 3, 2>> r;
+  for (auto _ : state) {
+    r = solve_bvp(bvp, guess, options(static_cast<int>(state.range(1)), 1e-10));
+    benchmark::ClobberMemory();
+  }
+  report(state, r);
+}
+
+void electron_paper(benchmark::State& state) {
+  const int N = static_cast<int>(state.range(0));
+  const auto bvp = electron_bvp(Electron{}, kT, N, kStart, kEnd, Closure::SecondOrder);
+  const auto guess = electron_guess(bvp, kStart, kEnd);
+  ShootingResult<Electron> r;
+  for (auto _ : state) {
+    r = solve_bvp(bvp, guess, options(static_cast<int>(state.range(1)), 1e-6));
+    benchmark::ClobberMemory();
+  }
+  report(state, r);
+}
+
+void beanie_paper(benchmark::State& state) {
+  const int N = static_cast<int>(state.range(0));
+  BeanieControl b;
+  b.par = {1.0, 1.0, 0.5, 1.0};
+  b.variant = BeanieConstraints::ExactRotation;
+  BeanieBoundary s, e;
+  s.Omega1 = 0.5, s.Omega2 = 0.2;
+  e.psi = 1.0, e.theta = 1.0;
+  const auto bvp = beanie_bvp(b, kT, N, s, e, Closure::SecondOrder);
+  const auto guess = beanie_guess(bvp, s, e);
+  ShootingResult<BeanieControl> r;
+  for (auto _ : state) {
+    r = solve_bvp(bvp, guess, options(static_cast<int>(state.range(1)), 1e-6));
+    benchmark::ClobberMemory();
+  }
+  report(state, r);
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  for (int threads : {1, 2}) {
+    for (int N : {1000, 10000, 100000})
+      benchmark::RegisterBenchmark("BM_ElectronGalerkin4", electron_galerkin)->Args({N, threads})->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+    for (int N : {1000, 3000, 10000})
+      benchmark::RegisterBenchmark("BM_ElectronPaper", electron_paper)->Args({N, threads})->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+    for (int N : {1000, 2000, 4000})
+      benchmark::RegisterBenchmark("BM_BeaniePaper", beanie_paper)->Args({N, threads})->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+  }
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
