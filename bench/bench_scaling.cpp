@@ -75,9 +75,9 @@ void beanie_paper(benchmark::State& state) {
   BeanieControl b;
   b.par = {1.0, 1.0, 0.5, 1.0};
   b.variant = BeanieConstraints::ExactRotation;
-  BeanieBoundary s, e;
-  s.Omega1 = 0.5, s.Omega2 = 0.2;
-  e.psi = 1.0, e.theta = 1.0;
+  BeanieBoundary s, e;  // bench_shooting's well-posed data
+  s.psi = 0.0, s.psi_dot = 0.0, s.theta = 0.0, s.x = 0.0, s.y = 0.0, s.Omega1 = 0.5, s.Omega2 = 0.2;
+  e.psi = 1.0, e.psi_dot = 0.0, e.theta = 1.0;
   const auto bvp = beanie_bvp(b, kT, N, s, e, Closure::SecondOrder);
   const auto guess = beanie_guess(bvp, s, e);
   ShootingResult<BeanieControl> r;
