@@ -46,28 +46,29 @@ void report(benchmark::State& state, const R& r) {
   if (!r.ok()) state.SetLabel(std::string(status_name(r.status)) + ": " + r.message);
 }
 
+// Times solve_bvp (problem and guess built outside the loop) and reports the last result.
+template <class BVP, class Guess>
+void timed_solves(benchmark::State& state, const BVP& bvp, const Guess& guess, double tolerance) {
+  decltype(solve_bvp(bvp, guess)) r;
+  for (auto _ : state) {
+    r = solve_bvp(bvp, guess, options(static_cast<int>(state.range(1)), tolerance));
+    benchmark::ClobberMemory();
+  }
+  report(state, r);
+}
+
 void electron_galerkin(benchmark::State& state) {
   const int N = static_cast<int>(state.range(0));
   const auto bvp = electron_galerkin_bvp<3>(model_of(Electron{}), kT, N, kStart, kEnd);
   const auto guess = electron_galerkin_guess<3>(bvp, kStart, kEnd);
-  ShootingResult<Galerkin<ElectronModel, 3, 2>> r;
-  for (auto _ : state) {
-    r = solve_bvp(bvp, guess, options(static_cast<int>(state.range(1)), 1e-10));
-    benchmark::ClobberMemory();
-  }
-  report(state, r);
+  timed_solves(state, bvp, guess, 1e-10);
 }
 
 void electron_paper(benchmark::State& state) {
   const int N = static_cast<int>(state.range(0));
   const auto bvp = electron_bvp(Electron{}, kT, N, kStart, kEnd, Closure::SecondOrder);
   const auto guess = electron_guess(bvp, kStart, kEnd);
-  ShootingResult<Electron> r;
-  for (auto _ : state) {
-    r = solve_bvp(bvp, guess, options(static_cast<int>(state.range(1)), 1e-6));
-    benchmark::ClobberMemory();
-  }
-  report(state, r);
+  timed_solves(state, bvp, guess, 1e-6);
 }
 
 void beanie_paper(benchmark::State& state) {
@@ -80,12 +81,7 @@ void beanie_paper(benchmark::State& state) {
   e.psi = 1.0, e.psi_dot = 0.0, e.theta = 1.0;
   const auto bvp = beanie_bvp(b, kT, N, s, e, Closure::SecondOrder);
   const auto guess = beanie_guess(bvp, s, e);
-  ShootingResult<BeanieControl> r;
-  for (auto _ : state) {
-    r = solve_bvp(bvp, guess, options(static_cast<int>(state.range(1)), 1e-6));
-    benchmark::ClobberMemory();
-  }
-  report(state, r);
+  timed_solves(state, bvp, guess, 1e-6);
 }
 }  // namespace
 
