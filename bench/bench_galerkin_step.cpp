@@ -1,5 +1,7 @@
 // One Galerkin flow step (METHOD.md §9), derived by automatic differentiation: the step's Newton
-// solve and its sensitivity (implicit function theorem), beanie and electron, orders 4 and 6.
+// solve and its sensitivity (implicit function theorem), beanie and electron, orders 4 and 6; and
+// the cost per step inside a 200-step flow with and without sensitivities (where each step's
+// Newton starts from the previous step's matrix).
 //   ./build/bench/bench_galerkin_step --benchmark_repetitions=7 --benchmark_report_aggregates_only=true
 #include <lpshoot/problems/beanie_bvp.hpp>
 #include <lpshoot/problems/electron_bvp.hpp>
@@ -47,6 +49,22 @@ void step(benchmark::State& st, const typename Sch::Model& model, const Interval
   }
 }
 
+// Per step of a 200-step flow from `start`, with the full state seeded (as shooting does) or not.
+template <class Sch>
+void flow(benchmark::State& st, const typename Sch::Model& model, const Interval<Sch, double>& start, bool sensitivity) {
+  constexpr int steps = 200;
+  const GalerkinFlow<Sch> f(model, kH);
+  const Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(Sch::state, Sch::state);
+  for (auto _ : st) {
+    auto r = f.run(start, steps, sensitivity ? &seed : nullptr, Sch::Group::template identity<double>(), 0, false);
+    if (!r.report.ok()) st.SkipWithError(r.report.message.c_str());
+    benchmark::DoNotOptimize(r.sensitivity.data());
+  }
+  // Seconds per step (printed with an SI prefix: 120u = 120 µs).
+  st.counters["per_step"] = benchmark::Counter(static_cast<double>(steps) * st.iterations(),
+                                               benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
 BeanieModel beanie() {
   BeanieModel b;
   b.par = {1.0, 1.0, 0.5, 1.0};
@@ -69,5 +87,20 @@ static void BM_ElectronGalerkinStep(benchmark::State& st) {
 }
 BENCHMARK_TEMPLATE(BM_ElectronGalerkinStep, 3)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 BENCHMARK_TEMPLATE(BM_ElectronGalerkinStep, 4)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+template <int S>
+static void BM_BeanieGalerkinFlow(benchmark::State& st) {
+  flow<BeanieGalerkin<S>>(st, beanie(), beanie_start<S>(beanie()), st.range(0) != 0);
+}
+BENCHMARK_TEMPLATE(BM_BeanieGalerkinFlow, 3)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_BeanieGalerkinFlow, 4)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+template <int S>
+static void BM_ElectronGalerkinFlow(benchmark::State& st) {
+  const ElectronModel m = model_of(Electron{});
+  flow<ElectronGalerkin<S>>(st, m, electron_start<S>(m), st.range(0) != 0);
+}
+BENCHMARK_TEMPLATE(BM_ElectronGalerkinFlow, 3)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_ElectronGalerkinFlow, 4)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

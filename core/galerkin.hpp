@@ -84,7 +84,7 @@ GroupCurveEnds<Sch, T> group_curve_ends(const typename Sch::Model& model, const 
   e.zeta = G::log(iv.W);
   e.omega0 = iv.Om - connection_velocity(model, iv.x, iv.v);
   const Vec<T, Sch::d> end_velocity = iv.Om_end(h) - connection_velocity(model, iv.x_end(h), iv.v_end(h));
-  e.omega1 = solve_small<T, Sch::d>(right_jacobian<G, T>(e.zeta), end_velocity);
+  e.omega1 = right_jacobian_inverse<G, T>(e.zeta) * end_velocity;
   return e;
 }
 

@@ -7,6 +7,7 @@
 #pragma once
 
 #include "groups.hpp"
+#include "scalar_tower.hpp"
 #include "taylor.hpp"
 
 #include <utility>
@@ -25,20 +26,6 @@ void body_velocity_jet(const typename G::template Tangent<Taylor2<T>>& xi, typen
     Omega(a) = rel(a).c1;
     dOmega(a) = 2.0 * rel(a).c2;
   }
-}
-
-template <class G, class T>
-Eigen::Matrix<T, G::dim, G::dim> right_jacobian(const typename G::template Tangent<T>& zeta) {
-  constexpr int d = G::dim;
-  using TD = Dual<T, d>;
-  typename G::template Tangent<TD> z;
-  for (int a = 0; a < d; ++a) z(a) = TD::variable(zeta(a), a);
-  const auto start_inverse = G::template cast<TD>(G::inverse(G::template exp<T>(zeta)));
-  const typename G::template Tangent<TD> rel = G::log(G::compose(start_inverse, G::template exp<TD>(z)));
-  Eigen::Matrix<T, d, d> J;
-  for (int i = 0; i < d; ++i)
-    for (int j = 0; j < d; ++j) J(i, j) = rel(i).d[j];
-  return J;
 }
 
 // x = A^{-1} b for a small square A in any scalar (Gaussian elimination, partial pivoting on the
@@ -67,6 +54,63 @@ Eigen::Matrix<T, n, 1> solve_small(Eigen::Matrix<T, n, n> A, Eigen::Matrix<T, n,
     x(i) = s / A(i, i);
   }
   return x;
+}
+
+namespace detail {
+template <class G, class T>
+Eigen::Matrix<T, G::dim, G::dim> right_jacobian_direct(const typename G::template Tangent<T>& zeta) {
+  constexpr int d = G::dim;
+  using TD = Dual<T, d>;
+  typename G::template Tangent<TD> z;
+  for (int a = 0; a < d; ++a) z(a) = TD::variable(zeta(a), a);
+  const auto start_inverse = G::template cast<TD>(G::inverse(G::template exp<T>(zeta)));
+  const typename G::template Tangent<TD> rel = G::log(G::compose(start_inverse, G::template exp<TD>(z)));
+  Eigen::Matrix<T, d, d> J;
+  for (int i = 0; i < d; ++i)
+    for (int j = 0; j < d; ++j) J(i, j) = rel(i).d[j];
+  return J;
+}
+}  // namespace detail
+
+template <class G, class T>
+Eigen::Matrix<T, G::dim, G::dim> right_jacobian(const typename G::template Tangent<T>& zeta) {
+  return detail::right_jacobian_direct<G, T>(zeta);
+}
+
+// Jr(ζ)^{-1}. In nested duals (first or second derivatives), from Jr^{-1} and its first and
+// second derivatives in ζ computed in double duals of width d, then the chain rule
+// (scalar_tower.hpp): the group's exp/log are not run in the nested type.
+template <class G, class T>
+Eigen::Matrix<T, G::dim, G::dim> right_jacobian_inverse(const typename G::template Tangent<T>& zeta) {
+  constexpr int d = G::dim;
+  constexpr int K = derivative_order<T>::value;
+  auto invert = [](const auto& J) {
+    using S = typename std::decay_t<decltype(J)>::Scalar;
+    Eigen::Matrix<S, d, d> R;
+    for (int j = 0; j < d; ++j) {
+      Eigen::Matrix<S, d, 1> e = Eigen::Matrix<S, d, 1>::Constant(S(0.0));
+      e(j) = S(1.0);
+      R.col(j) = solve_small<S, d>(J, e);
+    }
+    return R;
+  };
+  if constexpr (K == 0 || K > 2 || !detail::is_dual_over_double<T, K>::value) {
+    return invert(right_jacobian<G, T>(zeta));
+  } else {
+    using D = std::conditional_t<K == 1, Dual<double, d>, Dual<Dual<double, d>, d>>;
+    typename G::template Tangent<D> z;
+    for (int a = 0; a < d; ++a) {
+      if constexpr (K == 1)
+        z(a) = D::variable(value(zeta(a)), a);
+      else
+        z(a) = D::variable(Dual<double, d>::variable(value(zeta(a)), a), a);
+    }
+    const Eigen::Matrix<D, d, d> R = invert(detail::right_jacobian_direct<G, D>(z));
+    Eigen::Matrix<T, d, d> out;
+    for (int i = 0; i < d; ++i)
+      for (int j = 0; j < d; ++j) out(i, j) = detail::lift_multivariate<T>(R(i, j), zeta);
+    return out;
+  }
 }
 
 }  // namespace lpshoot

@@ -6,7 +6,7 @@
 // 2 sin^2(w/2)/w, which has no cancellation.
 #pragma once
 
-#include "dual.hpp"
+#include "scalar_tower.hpp"
 
 #include <cmath>
 
@@ -47,18 +47,29 @@ T alternating_series(const T& w, int shift) {
 }
 
 template <class T>
-T sinc(const T& w) {
+T sinc_value(const T& w) {
   using std::sin;
   if (std::abs(value(w)) < kSeriesRadius) return alternating_series(w, 0);
   return sin(w) / w;
 }
 
 template <class T>
-T cosc(const T& w) {
+T cosc_value(const T& w) {
   using std::sin;
   if (std::abs(value(w)) < kSeriesRadius) return w * alternating_series(w, 1);
   const T s = sin(w * 0.5);
   return 2.0 * s * s / w;
+}
+
+// In AD types, by their derivatives at the value (scalar_tower.hpp), not Horner in the type.
+template <class T>
+T sinc(const T& w) {
+  return apply_univariate(w, [](const auto& y) { return sinc_value(y); });
+}
+
+template <class T>
+T cosc(const T& w) {
+  return apply_univariate(w, [](const auto& y) { return cosc_value(y); });
 }
 
 // Angle wrapped to (-pi, pi], derivative 1.

@@ -249,6 +249,36 @@ void check_flow_sensitivity() {
 TEST(GalerkinFlow, SensitivityMatchesFiniteDifferences) { check_flow_sensitivity<3>(); }
 TEST(GalerkinFlow, SensitivityWithBubblesMatchesFiniteDifferences) { check_flow_sensitivity<4>(); }
 
+// With sensitivities each step's Newton starts with the previous step's matrix at its solution
+// (chord iterations, newton_solve's `previous`); without, with its own exact Jacobian. Both must
+// land on the same solution to the step tolerance, and report the same regularity.
+template <int S>
+void check_reused_step_matrices() {
+  using BG = BeanieGalerkin<S>;
+  BeanieModel model;
+  model.par = {1.0, 1.0, 0.5, 1.0};
+  const double h = 0.02;
+  const auto start = beanie_interval_with_multipliers<S>(model, 4.0, 200);
+  const GalerkinFlow<BG> flow(model, h);
+  const Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(BG::state, BG::state);
+  const auto plain = flow.run(start, 150, nullptr);
+  const auto seeded = flow.run(start, 150, &seed);
+  ASSERT_TRUE(plain.report.ok()) << plain.report.message;
+  ASSERT_TRUE(seeded.report.ok()) << seeded.report.message;
+  double worst = 0;
+  for (size_t n = 0; n < plain.trajectory.intervals.size(); ++n)
+    worst = std::max(worst, state_difference(seeded.trajectory.intervals[n], plain.trajectory.intervals[n], h)
+                                .template lpNorm<Eigen::Infinity>());
+  std::printf("degree %d, 150 steps: seeded and plain flows differ by %.2e; max conditions %.4g and %.4g\n", S, worst,
+              seeded.report.max_condition, plain.report.max_condition);
+  EXPECT_LT(worst, 1e-10);
+  // The seeded flow checks each step matrix at the solution; the plain one at its first iterate.
+  EXPECT_NEAR(seeded.report.max_condition, plain.report.max_condition, 0.05 * plain.report.max_condition);
+}
+
+TEST(GalerkinFlow, ReusedStepMatricesLandOnTheSameSolution) { check_reused_step_matrices<3>(); }
+TEST(GalerkinFlow, ReusedStepMatricesLandOnTheSameSolutionWithBubbles) { check_reused_step_matrices<4>(); }
+
 TEST(GalerkinFlow, TooFewGaussPointsMakeTheStepSingular) {
   // A cubic with one Gauss point (and a quartic with two) cannot see every direction of the
   // interval: the step matrix is singular, and the regularity check names the step.
@@ -262,7 +292,19 @@ TEST(GalerkinFlow, TooFewGaussPointsMakeTheStepSingular) {
     iv.w.setZero();
     return GalerkinFlow<Sch>(model_of(e), 0.1).run(iv, 5, nullptr, {}, 3).report;
   };
-  for (const FlowReport& rep : {first_failure(Galerkin<ElectronModel, 3, 1>{}), first_failure(Galerkin<ElectronModel, 4, 2>{})}) {
+  // With sensitivities too (their flow checks the step matrix at each solution as well).
+  auto first_failure_seeded = [&](auto scheme) {
+    using Sch = decltype(scheme);
+    const auto bvp3 = electron_galerkin_bvp<3>(model_of(e), 2.0, 20, kStart, kEnd);
+    const auto guess = electron_galerkin_guess<3>(bvp3, kStart, kEnd).trajectory.intervals[3];
+    Interval<Sch, double> iv;
+    iv.x = guess.x, iv.v = guess.v, iv.X2 = guess.X2, iv.V1 = guess.V1;
+    iv.w.setZero();
+    const Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(Sch::state, Sch::state);
+    return GalerkinFlow<Sch>(model_of(e), 0.1).run(iv, 5, &seed, {}, 3).report;
+  };
+  for (const FlowReport& rep : {first_failure(Galerkin<ElectronModel, 3, 1>{}), first_failure(Galerkin<ElectronModel, 4, 2>{}),
+                                first_failure_seeded(Galerkin<ElectronModel, 3, 1>{})}) {
     EXPECT_EQ(rep.status, FlowStatus::Singular) << rep.message;
     EXPECT_EQ(rep.failed_step, 4);
     EXPECT_NE(rep.message.find("step n=4"), std::string::npos) << rep.message;
