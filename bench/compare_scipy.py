@@ -13,8 +13,11 @@ y = (psi, psi', u, u'). Reference: shooting on (u(0), u'(0)) with DOP853 at rtol
 
 scipy's solve_bvp (4th-order collocation) gets the continuous optimality system written by hand,
 with analytic fun_jac and bc_jac, vectorized; lpshoot gets the scene only (it derives its
-equations from the Lagrangian). Timed: the solve_bvp call; lpshoot's solve (wall_time_s of the
-report, not the process start). Error: max over lpshoot's nodes (scipy: over 401 points) of the
+equations from the Lagrangian). Timed: the solve_bvp call (repetitions in one Python process);
+lpshoot's solve (wall_time_s of the report, not the process start), warm: all grids in one
+`lpshoot sweep` process after a warm-up grid (a new process's first solve also pays page faults
+and lazy symbol binding, ~1.3 ms; that time is printed too). Error: max over lpshoot's nodes
+(scipy: over 401 points) of the
 positions (electron) or of psi, theta, x, y (beanie).
 
 usage: /usr/bin/python3 bench/compare_scipy.py [path/to/lpshoot] [repetitions]
@@ -159,29 +162,42 @@ def scipy_rows(prob):
             sol, at = prob.scipy(tol)
             times.append(time.perf_counter() - t0)
         err = float(np.max(np.abs(at(sol, ts) - ref)))
-        rows.append((f"tol {tol:g} ({sol.x.size} nodes)", sol.status == 0, err, statistics.median(times)))
+        rows.append((f"tol {tol:g} ({sol.x.size} nodes)", sol.status == 0, err, statistics.median(times), None))
     return rows
 
 
+WARMUP_N = 5  # a grid no curve uses: the first solve of a process pays its cold start
+
+
 def lpshoot_rows(prob, scheme):
+    """Rows (setting, converged, error, warm time, new-process time). The error is read from the
+    trajectory of a `solve` (a new process, whose solve time is also kept). The warm time: every
+    grid in one `lpshoot sweep` process after a warm-up grid, as scipy's repetitions run in one
+    warm Python process; median over REPS sweeps."""
     obj, grids = SCHEMES[scheme]
     rows = []
+    scene = os.path.join(SCENES, prob.scene + ".json")
+    common = ["--set", "solver.segments=auto", "--set", "scheme=" + json.dumps(obj), "--no-plot", "--quiet"]
     with tempfile.TemporaryDirectory() as out:
+        warm = {N: [] for N in grids}
+        for _ in range(REPS):
+            subprocess.run([LPSHOOT, "sweep", scene, "--N", ",".join(str(n) for n in [WARMUP_N] + grids),
+                            "--scheme", scheme] + common + ["--out", out], check=False, capture_output=True)
+            with open(os.path.join(out, "sweep.json")) as f:
+                for run in json.load(f)["runs"]:
+                    if run["N"] in warm and run["converged"]:
+                        warm[run["N"]].append(run["wall_time_s"])
         for N in grids:
-            times, ok, err = [], True, None
-            for _ in range(REPS):
-                subprocess.run([LPSHOOT, "solve", os.path.join(SCENES, prob.scene + ".json"), "--set", f"horizon.N={N}",
-                                "--set", "solver.segments=auto", "--set", "scheme=" + json.dumps(obj), "--no-plot",
-                                "--quiet", "--out", out], check=False, capture_output=True)
-                with open(os.path.join(out, "report.json")) as f:
-                    r = json.load(f)
-                ok = ok and r["converged"]
-                times.append(r["wall_time_s"])
+            subprocess.run([LPSHOOT, "solve", scene, "--set", f"horizon.N={N}"] + common + ["--out", out],
+                           check=False, capture_output=True)
+            with open(os.path.join(out, "report.json")) as f:
+                r = json.load(f)
+            ok, err = r["converged"] and len(warm[N]) == REPS, None
             if ok:
                 data = np.genfromtxt(os.path.join(out, "trajectory.csv"), delimiter=",", names=True)
                 got = np.column_stack([data[c] for c in prob.columns])
                 err = float(np.max(np.abs(got - prob.exact(data["t"]))))
-            rows.append((f"N = {N}", ok, err, statistics.median(times)))
+            rows.append((f"N = {N}", ok, err, statistics.median(warm[N]) if ok else float("nan"), r["wall_time_s"]))
     return rows
 
 
@@ -201,18 +217,19 @@ def main():
         curves = {"scipy solve_bvp": scipy_rows(prob)}
         for s in SCHEMES:
             curves["lpshoot " + s] = lpshoot_rows(prob, s)
-        print("| solver | setting | converged | error | time [ms] |")
-        print("|---|---|---|---|---|")
+        print("| solver | setting | converged | error | time [ms] | lpshoot: solve time in a new process [ms] |")
+        print("|---|---|---|---|---|---|")
         for name, rows in curves.items():
-            for setting, ok, err, t in rows:
+            for setting, ok, err, t, cold in rows:
                 e = f"{err:.2e}" if err is not None else "-"
-                print(f"| {name} | {setting} | {ok} | {e} | {1e3 * t:.2f} |")
-        ref = {lv: time_for([(e, t) for _, ok, e, t in curves["scipy solve_bvp"] if ok], lv) for lv in LEVELS}
+                c = f"{1e3 * cold:.2f}" if cold is not None else "-"
+                print(f"| {name} | {setting} | {ok} | {e} | {1e3 * t:.2f} | {c} |")
+        ref = {lv: time_for([(e, t) for _, ok, e, t, _ in curves["scipy solve_bvp"] if ok], lv) for lv in LEVELS}
         print("\n| error level | " + " | ".join(f"{n} [ms]" for n in curves) + " | " +
               " | ".join(f"{n} / scipy" for n in list(curves)[1:]) + " |")
         print("|---" * (2 * len(curves)) + "|")
         for lv in LEVELS:
-            ts = [time_for([(e, t) for _, ok, e, t in rows if ok], lv) for rows in curves.values()]
+            ts = [time_for([(e, t) for _, ok, e, t, _ in rows if ok], lv) for rows in curves.values()]
             cells = [f"{1e3 * t:.2f}" if t else "-" for t in ts]
             ratios = [f"{t / ref[lv]:.2f}" if t and ref[lv] else "n/a" for t in ts[1:]]
             print(f"| {lv:g} | " + " | ".join(cells) + " | " + " | ".join(ratios) + " |")

@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -126,12 +127,27 @@ class DiscreteFlow {
 
     FlowState<P> s = initial;
     Eigen::MatrixXd next;
+    // With sensitivities, each step's matrix at its solution comes with them; the next step's
+    // Newton iterates with it first (newton_solve, `previous`).
+    Eigen::Matrix<double, D::unknowns, D::unknowns> step_matrix;
+    bool have_step_matrix = false;
     for (int n = k; n <= N - k; ++n) {
       StepUnknowns<P> z;
-      if (!rep.add(solve_step(problem_, h_, s, n, options_, z))) return out;
+      if (!rep.add(solve_step(problem_, h_, s, n, options_, z, have_step_matrix ? &step_matrix : nullptr)))
+        return out;
       if (seed) {
         // New state = shifted old state + z; the new rows come from the implicit function theorem.
-        const Eigen::Matrix<double, D::unknowns, ns> dz = step_sensitivity(problem_, h_, s, z);
+        double condition = 0;
+        const Eigen::Matrix<double, D::unknowns, ns> dz = step_sensitivity(problem_, h_, s, z, &step_matrix, &condition);
+        rep.max_condition = std::max(rep.max_condition, condition);
+        if (!(condition <= options_.max_condition)) {  // regular at the predictor, not at the solution
+          --rep.steps;
+          rep.status = FlowStatus::Singular;
+          rep.failed_step = n;
+          rep.message = "step n=" + std::to_string(n) + ": " + singular_step_reason(condition, options_.max_condition);
+          return out;
+        }
+        have_step_matrix = true;
         const Eigen::MatrixXd& S = out.sensitivity;
         const Eigen::MatrixXd dzS = dz * S.topRows(ns);  // the state's rows (not the group element's)
         next.resize(S.rows(), S.cols());

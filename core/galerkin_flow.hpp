@@ -85,11 +85,29 @@ class GalerkinFlow {
     if (seed) out.sensitivity = *seed;
     Eigen::MatrixXd next;
     Interval<Sch, double> s = start;
+    // With sensitivities, each step's matrix at its solution comes with them; the next step's
+    // Newton iterates with it first (newton_solve, `previous`).
+    Eigen::Matrix<double, nz, nz> step_matrix;
+    bool have_step_matrix = false;
     for (int k = 1; k <= steps; ++k) {
       Interval<Sch, double> z;
-      if (!rep.add(solve_galerkin_step<Sch>(model_, h_, s, first_node + k, options_, z))) return out;
+      if (!rep.add(solve_galerkin_step<Sch>(model_, h_, s, first_node + k, options_, z,
+                                            have_step_matrix ? &step_matrix : nullptr)))
+        return out;
       if (seed) {
-        const Eigen::Matrix<double, nz, ns> dz = galerkin_step_sensitivity<Sch>(model_, h_, s, z);
+        double condition = 0;
+        const Eigen::Matrix<double, nz, ns> dz =
+            galerkin_step_sensitivity<Sch>(model_, h_, s, z, &step_matrix, &condition);
+        rep.max_condition = std::max(rep.max_condition, condition);
+        if (!(condition <= options_.max_condition)) {  // regular at the predictor, not at the solution
+          --rep.steps;
+          rep.status = FlowStatus::Singular;
+          rep.failed_step = first_node + k;
+          rep.message = "step n=" + std::to_string(first_node + k) + ": " +
+                        singular_step_reason(condition, options_.max_condition);
+          return out;
+        }
+        have_step_matrix = true;
         const Eigen::MatrixXd& S = out.sensitivity;
         next.resize(S.rows(), S.cols());
         // The base node of interval n is the end of interval n-1.

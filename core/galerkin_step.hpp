@@ -225,9 +225,11 @@ void apply_galerkin_correction(Interval<Sch, double>& z, const Vec<double, Sch::
 
 // Solves step n (interval n from interval n-1 = `state`) by Newton from the predictor "interval
 // n-1's unknowns"; on return z is interval n (its base node included).
+// `previous`: the step matrix of step n-1 at its solution, for chord iterations (newton_solve).
 template <class Sch>
 StepReport solve_galerkin_step(const typename Sch::Model& model, double h, const Interval<Sch, double>& state, int n,
-                               const NewtonOptions& opt, Interval<Sch, double>& z) {
+                               const NewtonOptions& opt, Interval<Sch, double>& z,
+                               const Eigen::Matrix<double, Sch::unknowns, Sch::unknowns>* previous = nullptr) {
   constexpr int r = Sch::r, d = Sch::d, nz = Sch::unknowns, nv = Sch::variation;
   z = state;
   const Interval<Sch, double> base = next_interval_base(state, h);
@@ -254,21 +256,27 @@ StepReport solve_galerkin_step(const typename Sch::Model& model, double h, const
         scale.template segment<d>(2 * r) = z.O1.cwiseAbs();
         scale.template tail<Sch::aux>() = z.w.cwiseAbs();
         return scale;
-      });
+      },
+      previous);
 }
 
-// dz/d(state) at a solved step (nz x ns), by the implicit function theorem.
+// dz/d(state) at a solved step (nz x ns), by the implicit function theorem. Optionally the step
+// matrix ∂F/∂z there (for the next step's chord iterations) and its 1-norm condition number (the
+// regularity check at the solution).
 template <class Sch>
-Eigen::Matrix<double, Sch::unknowns, Sch::state> galerkin_step_sensitivity(const typename Sch::Model& model, double h,
-                                                                           const Interval<Sch, double>& state,
-                                                                           const Interval<Sch, double>& z) {
+Eigen::Matrix<double, Sch::unknowns, Sch::state> galerkin_step_sensitivity(
+    const typename Sch::Model& model, double h, const Interval<Sch, double>& state, const Interval<Sch, double>& z,
+    Eigen::Matrix<double, Sch::unknowns, Sch::unknowns>* step_matrix = nullptr, double* condition = nullptr) {
   constexpr int nz = Sch::unknowns, ns = Sch::state;
   Vec<double, nz> F;
   Eigen::Matrix<double, nz, nz + ns> J;
   evaluate_galerkin_step<Sch, nz + ns>(model, h, state, z, true, nullptr, F, J);
   const Eigen::Matrix<double, nz, nz> Jz = J.template leftCols<nz>();
   const Eigen::Matrix<double, nz, ns> Js = J.template rightCols<ns>();
-  return -Jz.partialPivLu().solve(Js);
+  const Eigen::PartialPivLU<Eigen::Matrix<double, nz, nz>> lu(Jz);
+  if (step_matrix) *step_matrix = Jz;
+  if (condition) *condition = condition_number_1(Jz, lu);
+  return -lu.solve(Js);
 }
 
 }  // namespace lpshoot

@@ -108,12 +108,22 @@ inline bool all_finite(const double* x, int n) {
   return true;
 }
 
+// The report of a step whose matrix (paper Proposition 2) is singular or too ill-conditioned.
+inline std::string singular_step_reason(double condition, double max_condition) {
+  return "the step matrix (Proposition 2) is singular (condition " + format_number(condition) + " > " +
+         format_number(max_condition) + ")";
+}
+
 // Solves F(z) = 0 for a step with n unknowns. The callbacks:
 //   jacobian(F, J): F and ∂F/∂z at the current z;  residual(F): F only;
 //   correct(dz): z <- z ⊕ dz;  magnitude(): |z_i| for the convergence test (0 for group parts).
+// `previous`, when given, is the exact step matrix of a neighbouring step at its solution (a flow's
+// previous step, already checked regular there): the first iterations are chord steps with it,
+// and the exact Jacobian is evaluated only when they stop contracting by 4x (the Jacobian reuse
+// of implicit integrators; the converged z is the same, to the step tolerance).
 template <int n, class Jacobian, class Residual, class Correct, class Magnitude>
 StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian, Residual&& residual, Correct&& correct,
-                        Magnitude&& magnitude) {
+                        Magnitude&& magnitude, const Eigen::Matrix<double, n, n>* previous = nullptr) {
   StepReport rep;
   rep.step = step;
   auto fail = [&](StepStatus st, const std::string& why) {
@@ -126,6 +136,11 @@ StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian,
   Eigen::Matrix<double, n, n> J;
   Eigen::PartialPivLU<Eigen::Matrix<double, n, n>> lu;
   bool refresh = true;
+  if (previous) {
+    lu.compute(*previous);
+    rep.condition = condition_number_1(*previous, lu);
+    refresh = !(rep.condition <= opt.max_condition);
+  }
   double last_step = std::numeric_limits<double>::infinity();
   double last_residual = std::numeric_limits<double>::infinity();
   constexpr double eps = std::numeric_limits<double>::epsilon();
@@ -138,9 +153,7 @@ StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian,
       lu.compute(J);
       rep.condition = condition_number_1(J, lu);
       if (!(rep.condition <= opt.max_condition))
-        return fail(StepStatus::Singular, "the step matrix (Proposition 2) is singular (condition " +
-                                              format_number(rep.condition) + " > " +
-                                              format_number(opt.max_condition) + ")");
+        return fail(StepStatus::Singular, singular_step_reason(rep.condition, opt.max_condition));
     } else {
       residual(F);
       if (!all_finite(F.data(), n)) return fail(StepStatus::NonFinite, "the step equations evaluated to a non-finite number");
