@@ -15,7 +15,7 @@ scipy's solve_bvp (4th-order collocation) gets the continuous optimality system 
 with analytic fun_jac and bc_jac, vectorized; lpshoot gets the scene only (it derives its
 equations from the Lagrangian). Timed: the solve_bvp call (repetitions in one Python process);
 lpshoot's solve (wall_time_s of the report, not the process start), warm: all grids in one
-`lpshoot sweep` process after a warm-up grid (a new process's first solve also pays page faults
+`lpshoot sweep` process after a smaller warm-up grid (a new process's first solve also pays page faults
 and lazy symbol binding, ~1.3 ms; that time is printed too). Error: max over lpshoot's nodes
 (scipy: over 401 points) of the
 positions (electron) or of psi, theta, x, y (beanie).
@@ -166,7 +166,10 @@ def scipy_rows(prob):
     return rows
 
 
-WARMUP_N = 5  # a grid no curve uses: the first solve of a process pays its cold start
+def warmup_grid(scheme, grids):
+    """A grid below every grid of the curve (sweep runs grids in increasing N): the first solve of
+    a process pays its cold start. The paper's windows need N >= 2k + 1 = 5."""
+    return max(5 if scheme == "paper" else 2, min(grids) // 2)
 
 
 def lpshoot_rows(prob, scheme):
@@ -181,7 +184,7 @@ def lpshoot_rows(prob, scheme):
     with tempfile.TemporaryDirectory() as out:
         warm = {N: [] for N in grids}
         for _ in range(REPS):
-            subprocess.run([LPSHOOT, "sweep", scene, "--N", ",".join(str(n) for n in [WARMUP_N] + grids),
+            subprocess.run([LPSHOOT, "sweep", scene, "--N", ",".join(str(n) for n in [warmup_grid(scheme, grids)] + grids),
                             "--scheme", scheme] + common + ["--out", out], check=False, capture_output=True)
             with open(os.path.join(out, "sweep.json")) as f:
                 for run in json.load(f)["runs"]:
