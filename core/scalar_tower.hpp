@@ -84,13 +84,11 @@ double value(const Poly<K>& p) {
   return p.a[0];
 }
 
-// sin and cos of x0 + u(s), u(0) = 0: Σ_k sin^(k)(x0) u^k / k!.
+// f(x0 + u(s)), u(0) = 0, for f with the period-4 derivative cycle d: Σ_k d[k mod 4] u^k / k!.
 template <int K>
-Poly<K> sin(const Poly<K>& x) {
-  Poly<K> u = x, r(std::sin(x.a[0])), uk(1.0);
+Poly<K> periodic_series(const Poly<K>& x, const double (&d)[4]) {
+  Poly<K> u = x, r(d[0]), uk(1.0);
   u.a[0] = 0.0;
-  const double s = std::sin(x.a[0]), c = std::cos(x.a[0]);
-  const double d[4] = {s, c, -s, -c};
   double fact = 1.0;
   for (int k = 1; k <= K; ++k) {
     uk = uk * u;
@@ -100,18 +98,14 @@ Poly<K> sin(const Poly<K>& x) {
   return r;
 }
 template <int K>
-Poly<K> cos(const Poly<K>& x) {
-  Poly<K> u = x, r(std::cos(x.a[0])), uk(1.0);
-  u.a[0] = 0.0;
+Poly<K> sin(const Poly<K>& x) {
   const double s = std::sin(x.a[0]), c = std::cos(x.a[0]);
-  const double d[4] = {c, -s, -c, s};
-  double fact = 1.0;
-  for (int k = 1; k <= K; ++k) {
-    uk = uk * u;
-    fact *= k;
-    r = r + uk * (d[k % 4] / fact);
-  }
-  return r;
+  return periodic_series(x, {s, c, -s, -c});
+}
+template <int K>
+Poly<K> cos(const Poly<K>& x) {
+  const double s = std::sin(x.a[0]), c = std::cos(x.a[0]);
+  return periodic_series(x, {c, -s, -c, s});
 }
 
 namespace detail {
