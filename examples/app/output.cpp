@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "interrupt.hpp"
+#include "problem.hpp"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -119,6 +120,20 @@ std::string lines(const std::string& file, const std::string& x, const std::stri
   return "'" + file + "' using '" + x + "':'" + y + "' with lines lw 2 title '" + title + "'";
 }
 
+// The panels of trajectory.png: the descriptor's, or its shape, group coordinates and outputs
+// against t; the free beanie's plane path, shape and orientation and body velocity.
+std::vector<PlotPanel> plot_panels(const Scene& scene) {
+  if (!scene.problem)
+    return {{"plane path", "x", {"y"}, true}, {"shape and orientation", "t", {"psi", "theta"}, false},
+            {"body velocity", "t", {"Omega1", "Omega2", "Omega3"}, false}};
+  const ProblemDescriptor& d = scene.problem->descriptor();
+  if (!d.plots.empty()) return d.plots;
+  std::vector<PlotPanel> panels = {{"shape", "t", d.shape, false}};
+  if (!d.group.empty()) panels.push_back({"group coordinates", "t", d.group, false});
+  if (!d.outputs.empty()) panels.push_back({"outputs", "t", d.outputs, false});
+  return panels;
+}
+
 std::string run_plot_script(const Scene& scene, const RunRecord& r, bool momentum_plot) {
   std::ostringstream s;
   s << "# lpshoot plots: run `gnuplot plot.gp` in this directory to redraw.\n"
@@ -127,25 +142,18 @@ std::string run_plot_script(const Scene& scene, const RunRecord& r, bool momentu
   char title[200];
   std::snprintf(title, sizeof title, "%s (%s): N = %d, h = %.4g%s", r.problem.c_str(), r.command.c_str(), r.N, r.h,
                 r.has_cost ? (", cost " + number(r.cost).substr(0, 10)).c_str() : "");
-  s << "set multiplot layout 1,3 title \"" << title << "\"\n";
+  const std::vector<PlotPanel> panels = plot_panels(scene);
+  s << "set multiplot layout 1," << panels.size() << " title \"" << title << "\"\n";
   const std::string f = "trajectory.csv";
-  if (scene.problem == ProblemKind::Electron) {
-    s << "set title 'plane path'\nset xlabel 'x1'\nset ylabel 'x2'\nset size ratio -1\n"
-      << "plot " << lines(f, "x1", "x2", "(x1, x2)") << "\nset size noratio\n"
-      << "set title 'position'\nset xlabel 't'\nset ylabel ''\n"
-      << "plot " << lines(f, "t", "x1", "x1") << ", " << lines(f, "t", "x2", "x2") << ", " << lines(f, "t", "x3", "x3") << "\n"
-      << "set title 'control u'\n"
-      << "plot " << lines(f, "t", "u1", "u1") << ", " << lines(f, "t", "u2", "u2") << ", " << lines(f, "t", "u3", "u3") << "\n";
-  } else {
-    s << "set title 'plane path'\nset xlabel 'x'\nset ylabel 'y'\nset size ratio -1\n"
-      << "plot " << lines(f, "x", "y", "(x, y)") << "\nset size noratio\n"
-      << "set title 'shape and orientation'\nset xlabel 't'\nset ylabel ''\n"
-      << "plot " << lines(f, "t", "psi", "psi") << ", " << lines(f, "t", "theta", "theta") << "\n";
-    if (scene.problem == ProblemKind::Beanie)
-      s << "set title 'control u'\nplot " << lines(f, "t", "u", "u") << "\n";
-    else
-      s << "set title 'body velocity'\nplot " << lines(f, "t", "Omega1", "Omega1") << ", "
-        << lines(f, "t", "Omega2", "Omega2") << ", " << lines(f, "t", "Omega3", "Omega3") << "\n";
+  for (const PlotPanel& panel : panels) {
+    s << "set title '" << panel.title << "'\nset xlabel '" << panel.x << "'\nset ylabel '"
+      << (panel.equal_axes && panel.y.size() == 1 ? panel.y.front() : "") << "'\n"
+      << (panel.equal_axes ? "set size ratio -1\n" : "");
+    s << "plot ";
+    for (size_t i = 0; i < panel.y.size(); ++i)
+      s << (i ? ", " : "")
+        << lines(f, panel.x, panel.y[i], panel.equal_axes ? "(" + panel.x + ", " + panel.y[i] + ")" : panel.y[i]);
+    s << "\n" << (panel.equal_axes ? "set size noratio\n" : "");
   }
   s << "unset multiplot\nset output\n";
   if (momentum_plot) {

@@ -1,4 +1,6 @@
 // Which runner a command and a scene call for.
+#include "paper_problems.hpp"
+#include "problem.hpp"
 #include "run.hpp"
 
 #include <algorithm>
@@ -7,49 +9,24 @@
 
 namespace lpshoot::app {
 
-std::string check_boundary(const Scene& s) {
-  try {
-    // Counting does not depend on the Galerkin degree: the cubic scheme's problem stands for all.
-    if (s.galerkin() && s.problem == ProblemKind::Electron)
-      return check_counting(problems::electron_galerkin_bvp<3>(problems::model_of(s.electron), s.T, s.N, s.electron_start,
-                                                               s.electron_end));
-    if (s.galerkin() && s.problem == ProblemKind::Beanie)
-      return check_counting(problems::beanie_galerkin_bvp<3>(problems::BeanieModel{s.beanie}, s.T, s.N, s.beanie_start,
-                                                             s.beanie_end));
-    if (s.problem == ProblemKind::Electron)
-      return check_counting(problems::electron_bvp(s.electron, s.T, s.N, s.electron_start, s.electron_end, s.closure));
-    if (s.problem == ProblemKind::Beanie) {
-      problems::BeanieControl b;
-      b.par = s.beanie;
-      b.variant = s.constraints;
-      return check_counting(problems::beanie_bvp(b, s.T, s.N, s.beanie_start, s.beanie_end, s.closure));
-    }
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "";
+std::string check_boundary(const Scene& s) { return s.problem ? s.problem->check_boundary(s) : ""; }
+
+ExactReference exact_reference(const Scene& s, const std::vector<double>& times) {
+  return s.problem ? s.problem->exact_reference(s, times) : ExactReference();
 }
 
 namespace {
 
 RunRecord run_one(const std::string& command, const Scene& s, const Progress& progress) {
   if (command == "simulate") {
-    if (s.problem != ProblemKind::BeanieFree)
+    if (s.problem)
       throw SceneError(s.file + ": problem: \"" + s.problem_name +
                        "\" is an optimal control problem (a boundary value problem): run `lpshoot solve` on it");
     return simulate_beanie_free(s, progress);
   }
-  switch (s.problem) {
-    case ProblemKind::Electron:
-      if (!s.galerkin()) return solve_electron(s, progress);
-      return s.galerkin_order == 6 ? solve_electron_galerkin_on<4>(s, progress) : solve_electron_galerkin_on<3>(s, progress);
-    case ProblemKind::Beanie:
-      if (!s.galerkin()) return solve_beanie(s, progress);
-      return s.galerkin_order == 6 ? solve_beanie_galerkin_on<4>(s, progress) : solve_beanie_galerkin_on<3>(s, progress);
-    case ProblemKind::BeanieFree:
-      throw SceneError(s.file + ": problem: \"beanie_free\" is a simulation from initial data: run `lpshoot simulate` on it");
-  }
-  return {};
+  if (!s.problem)
+    throw SceneError(s.file + ": problem: \"beanie_free\" is a simulation from initial data: run `lpshoot simulate` on it");
+  return s.problem->solve(s, progress);
 }
 
 // max over the state columns of |a - b| at the nodes of b's grid (every `stride`-th node of a).

@@ -89,16 +89,6 @@ struct RunRecord {
 // Progress lines for a terminal (the library never prints; the CLI decides where they go).
 using Progress = std::function<void(const std::string&)>;
 
-RunRecord solve_electron(const Scene& s, const Progress& progress);
-RunRecord solve_beanie(const Scene& s, const Progress& progress);
-// scheme.discretization "galerkin" with Hermite degree S (order 2S - 2); instantiated for S = 3, 4
-// in run_{electron,beanie}_galerkin{4,6}.cpp.
-template <int S>
-RunRecord solve_electron_galerkin_on(const Scene& s, const Progress& progress);
-template <int S>
-RunRecord solve_beanie_galerkin_on(const Scene& s, const Progress& progress);
-RunRecord simulate_beanie_free(const Scene& s, const Progress& progress);
-
 // Why the scene's boundary value problem is ill-posed by counting (METHOD.md §5), or "".
 std::string check_boundary(const Scene& s);
 

@@ -1,4 +1,5 @@
 // `solve` for the beanie optimal-control scene (METHOD.md §6.2).
+#include "paper_problems.hpp"
 #include "run_common.hpp"
 
 namespace lpshoot::app {
@@ -7,25 +8,25 @@ RunRecord solve_beanie(const Scene& s, const Progress& progress) {
   using problems::BeanieControl;
   RunRecord r = start_record("solve", s);
   describe_solver(s, r);
-  r.constraints = constraints_name(s.constraints);
+  r.constraints = s.scheme_options.at("constraints");
   const auto make = [](const Scene& sc) {
     BeanieControl bc;
-    bc.par = sc.beanie;
-    bc.variant = sc.constraints;
+    bc.par = beanie_parameters(sc.parameters);
+    bc.variant = beanie_constraints(sc);
     try {
-      return problems::beanie_bvp(bc, sc.T, sc.N, sc.beanie_start, sc.beanie_end, sc.closure);
+      return problems::beanie_bvp(bc, sc.T, sc.N, beanie_boundary(sc.start), beanie_boundary(sc.end), sc.closure);
     } catch (const std::invalid_argument& e) {
       throw SceneError(sc.file + ": boundary: " + e.what());
     }
   };
   const auto guess = [&](const BoundaryValueProblem<BeanieControl>& bvp) {
-    return problems::beanie_guess(bvp, s.beanie_start, s.beanie_end);
+    return problems::beanie_guess(bvp, beanie_boundary(s.start), beanie_boundary(s.end));
   };
   const auto res = solve_scene<BeanieControl>(s, make, guess, progress, r);
   record_outcome(res, r);
   BeanieControl b;
-  b.par = s.beanie;
-  b.variant = s.constraints;
+  b.par = beanie_parameters(s.parameters);
+  b.variant = beanie_constraints(s);
   const Trajectory<BeanieControl>& tr = res.trajectory;
   if (tr.N() != s.N) return r;
 
@@ -51,7 +52,7 @@ RunRecord solve_beanie(const Scene& s, const Progress& progress) {
   record_momentum(b, tr, res.g[0], r);
   // The beanie's physical momentum: the free L_d (76) along the same motion.
   problems::BeanieFree free;
-  free.par = s.beanie;
+  free.par = b.par;
   Trajectory<problems::BeanieFree> motion;
   motion.h = tr.h;
   motion.p = tr.p;

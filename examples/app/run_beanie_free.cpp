@@ -1,4 +1,5 @@
 // `simulate` for the free beanie scene: the k = 1 discrete flow from initial data.
+#include "paper_problems.hpp"
 #include "run_common.hpp"
 
 #include <chrono>
@@ -11,7 +12,7 @@ RunRecord simulate_beanie_free(const Scene& s, const Progress& progress) {
   RunRecord r = start_record("simulate", s);
   r.tolerance = s.shooting.step.step_tolerance;
   BeanieFree problem;
-  problem.par = s.beanie;
+  problem.par = beanie_parameters(s.parameters);
   const double h = s.h();
   Eigen::Vector4d q0, q1;
   if (s.beanie_free.configurations) {

@@ -1,4 +1,5 @@
 // `solve` for the electron scene (METHOD.md §6.1) and its exact continuous reference.
+#include "paper_problems.hpp"
 #include "run_common.hpp"
 
 #include <lpshoot/problems/electron_exact.hpp>
@@ -10,11 +11,13 @@ RunRecord solve_electron(const Scene& s, const Progress& progress) {
   RunRecord r = start_record("solve", s);
   describe_solver(s, r);
   const auto make = [](const Scene& sc) {
-    return problems::electron_bvp(sc.electron, sc.T, sc.N, sc.electron_start, sc.electron_end, sc.closure);
+    return problems::electron_bvp(electron_of(sc.parameters), sc.T, sc.N, electron_boundary(sc.start),
+                                  electron_boundary(sc.end), sc.closure);
   };
   const auto guess = [&](const BoundaryValueProblem<Electron>& bvp) {
-    return problems::electron_guess(bvp, s.electron_start, s.electron_end);
+    return problems::electron_guess(bvp, electron_boundary(s.start), electron_boundary(s.end));
   };
+  const Electron electron = electron_of(s.parameters);
   const auto res = solve_scene<Electron>(s, make, guess, progress, r);
   record_outcome(res, r);
   const Trajectory<Electron>& tr = res.trajectory;
@@ -27,7 +30,7 @@ RunRecord solve_electron(const Scene& s, const Progress& progress) {
     t.push_back(tr.time(n));
     for (int i = 0; i < 3; ++i) x[i].push_back(tr.p[n](i));
     if (n + Electron::order <= s.N) {
-      const Eigen::Vector3d un = s.electron.control(tr.window_at(n), tr.h);
+      const Eigen::Vector3d un = electron.control(tr.window_at(n), tr.h);
       for (int i = 0; i < 3; ++i) u[i][n] = un(i);
     }
   }
@@ -43,13 +46,11 @@ RunRecord solve_electron(const Scene& s, const Progress& progress) {
   return r;
 }
 
-ExactReference exact_reference(const Scene& s, const std::vector<double>& times) {
+ExactReference electron_exact_reference(const Scene& s, const std::vector<double>& times) {
   ExactReference ref;
-  if (s.problem != ProblemKind::Electron) return ref;
-  const auto& a = s.electron_start;
-  const auto& b = s.electron_end;
+  const problems::ElectronBoundary a = electron_boundary(s.start), b = electron_boundary(s.end);
   if (a.free_position || a.free_velocity || b.free_position || b.free_velocity) return ref;
-  const auto exact = problems::electron_exact_optimum(s.electron, s.T, a.position, a.velocity, b.position, b.velocity);
+  const auto exact = problems::electron_exact_optimum(electron_of(s.parameters), s.T, a.position, a.velocity, b.position, b.velocity);
   std::vector<std::vector<double>> x(3);
   for (double t : times) {
     const Eigen::Vector3d p = exact.position(t);

@@ -1,6 +1,8 @@
 // Scene parsing and validation (nlohmann-json stays in this file and in report.cpp).
 #include "scene.hpp"
 
+#include "problem.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -130,6 +132,18 @@ class Reader {
         throw SceneError(file_ + ": " + where + "[" + std::to_string(i) + "]: must be a finite number (got " +
                          v[i].dump() + ")");
       x(i) = v[i].get<double>();
+    }
+    return x;
+  }
+  std::vector<double> numbers(const std::string& key, size_t n) const {
+    const json& v = at(key);
+    if (!v.is_array() || v.size() != n)
+      fail("must be an array of " + std::to_string(n) + " numbers (got " + v.dump() + ")", key);
+    std::vector<double> x(n);
+    for (size_t i = 0; i < n; ++i) {
+      if (!v[i].is_number() || !std::isfinite(v[i].get<double>()))
+        fail("must be a finite number (got " + v[i].dump() + ")", key + "[" + std::to_string(i) + "]");
+      x[i] = v[i].get<double>();
     }
     return x;
   }
@@ -326,7 +340,7 @@ void apply_override(json& scene, const std::string& assignment) {
 ShootingMethod read_method(const std::string& s) { return s == "multiple" ? ShootingMethod::Multiple : ShootingMethod::Single; }
 
 void read_solver(const Reader& r, Scene& s) {
-  if (s.problem == ProblemKind::BeanieFree) {  // a simulation: only the per-step Newton is tuned
+  if (!s.problem) {  // a simulation: only the per-step Newton is tuned
     r.allow({"tolerance", "max_iterations"});
     s.shooting.step.step_tolerance = r.positive("tolerance", s.shooting.step.step_tolerance);
     // A relative Newton correction per step: above 1e-6 a step is not solved to an accuracy worth
@@ -366,70 +380,99 @@ void read_solver(const Reader& r, Scene& s) {
   if (s.shooting.threads < 0) r.fail("must be >= 0 (0: one per core)", "threads");
 }
 
-void read_electron(const Reader& root, Scene& s) {
-  const Reader par = root.object("parameters");
-  par.allow({"m", "e_over_c", "B", "potential"});
-  s.electron.mass = par.positive("m", 1.0);
-  s.electron.e_over_c = par.number("e_over_c", 1.0);
-  s.electron.B = par.has("B") ? par.vector<3>("B") : Eigen::Vector3d(0, 0, 1);
-  s.electron.potential = par.number("potential", 1.0);
-  const Reader bd = root.object("boundary");
-  bd.allow({"initial", "final"});
-  for (const char* side : {"initial", "final"}) {
-    problems::ElectronBoundary& b = std::string(side) == "initial" ? s.electron_start : s.electron_end;
-    b.free_position = b.free_velocity = true;
-    const std::optional<Reader> e = bd.optional_object(side);
-    if (!e) continue;
-    e->allow({"position", "velocity"});
-    if (e->has("velocity") && !e->has("position"))
-      e->fail("a velocity without a position is not supported (give the position too, or neither)", "velocity");
-    if (e->has("position")) b.position = e->vector<3>("position"), b.free_position = false;
-    if (e->has("velocity")) b.velocity = e->vector<3>("velocity"), b.free_velocity = false;
-  }
+// ---------------------------------------------------------------- the problem's own sections
+
+// The range a parameter's value must lie in, as a message, or "" when it does.
+std::string out_of_range(const ParameterSpec& p, double x) {
+  const bool above = p.min_exclusive ? x > p.min : x >= p.min;
+  if (above && x <= p.max) return "";
+  const std::string got = " (got " + Reader::format(x) + ")";
+  if (std::isfinite(p.min) && std::isfinite(p.max))
+    return "must be between " + Reader::format(p.min) + " and " + Reader::format(p.max) + got;
+  if (std::isfinite(p.max)) return "must be <= " + Reader::format(p.max) + got;
+  return std::string("must be ") + (p.min_exclusive ? "> " : ">= ") + Reader::format(p.min) + got;
 }
 
-void read_beanie_parameters(const Reader& root, Scene& s) {
-  const Reader par = root.object("parameters");
-  par.allow({"m", "I1", "I2", "potential"});
-  s.beanie.m = par.positive("m", 1.0);
-  s.beanie.I1 = par.positive("I1", 1.0);
-  s.beanie.I2 = par.positive("I2", 1.0);
-  s.beanie.amplitude = 0.0;
-  if (const auto pot = par.optional_object("potential")) {
-    pot->allow({"type", "amplitude"});
-    const std::string type = pot->choice("type", {"none", "cosine"}, "none");
-    if (type == "cosine") {
-      s.beanie.amplitude = pot->number("amplitude");
-    } else if (pot->has("amplitude")) {
-      pot->fail("is only used with type \"cosine\"", "amplitude");
+// The descriptor's parameters under `prefix` (a dotted key path, "" at the top) from the object
+// `r`; nested objects follow the keys' dots. Missing entries take their defaults.
+void read_parameter_object(const Reader* r, const std::string& prefix, const std::vector<ParameterSpec>& specs,
+                           ParameterValues& v) {
+  std::vector<std::string> children;  // the names directly under prefix, in the descriptor's order
+  for (const auto& p : specs) {
+    if (p.key.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string rest = p.key.substr(prefix.size());
+    const std::string child = rest.substr(0, rest.find('.'));
+    if (std::find(children.begin(), children.end(), child) == children.end()) children.push_back(child);
+  }
+  if (r) r->allow(children);
+  for (const auto& child : children) {
+    const std::string key = prefix + child;
+    const auto leaf = std::find_if(specs.begin(), specs.end(), [&](const ParameterSpec& p) { return p.key == key; });
+    if (leaf == specs.end()) {  // a nested object
+      if (r && r->has(child)) {
+        const Reader sub = r->object(child);
+        read_parameter_object(&sub, key + ".", specs, v);
+      } else {
+        read_parameter_object(nullptr, key + ".", specs, v);
+      }
+      continue;
+    }
+    const ParameterSpec& p = *leaf;
+    const bool given = r && r->has(child);
+    if (given) v.given.push_back(key);
+    switch (p.kind) {
+      case ParameterSpec::Kind::Choice:
+        v.words[key] = r ? r->choice(child, p.choices, p.choices.front()) : p.choices.front();
+        break;
+      case ParameterSpec::Kind::Number: {
+        const double x = given ? r->number(child) : p.value.front();
+        if (const std::string why = out_of_range(p, x); given && !why.empty()) r->fail(why, child);
+        v.numbers[key] = {x};
+        break;
+      }
+      case ParameterSpec::Kind::Array: {
+        const std::vector<double> x = given ? r->numbers(child, p.value.size()) : p.value;
+        for (size_t i = 0; given && i < x.size(); ++i)
+          if (const std::string why = out_of_range(p, x[i]); !why.empty()) r->fail(why, child + "[" + std::to_string(i) + "]");
+        v.numbers[key] = x;
+        break;
+      }
     }
   }
 }
 
-void read_beanie(const Reader& root, Scene& s) {
-  read_beanie_parameters(root, s);
+void read_parameters(const Reader& root, const Problem& problem, Scene& s) {
+  s.parameters = {};
+  const auto par = root.optional_object("parameters");
+  read_parameter_object(par ? &*par : nullptr, "", problem.descriptor().parameters, s.parameters);
+  if (const auto bad = problem.check_parameters(s.parameters))
+    root.fail(bad->second, "parameters." + bad->first);
+}
+
+// boundary.initial / boundary.final: the descriptor's entries; a missing one is free.
+void read_boundary(const Reader& root, const ProblemDescriptor& d, Scene& s) {
+  s.start = s.end = {};
+  if (!root.has("boundary")) return;
   const Reader bd = root.object("boundary");
   bd.allow({"initial", "final"});
+  std::vector<std::string> keys;
+  for (const auto& b : d.boundary) keys.push_back(b.key);
   for (const char* side : {"initial", "final"}) {
-    problems::BeanieBoundary& b = std::string(side) == "initial" ? s.beanie_start : s.beanie_end;
-    b = {};
+    BoundaryValues& values = std::string(side) == "initial" ? s.start : s.end;
     const std::optional<Reader> e = bd.optional_object(side);
     if (!e) continue;
-    e->allow({"psi", "psi_dot", "theta", "x", "y", "Omega1", "Omega2", "Omega3"});
-    if (e->has("psi_dot") && !e->has("psi")) e->fail("is given without psi (give psi too, or neither)", "psi_dot");
-    b.psi = e->optional_number("psi");
-    b.psi_dot = e->optional_number("psi_dot");
-    b.theta = e->optional_number("theta");
-    b.x = e->optional_number("x");
-    b.y = e->optional_number("y");
-    b.Omega1 = e->optional_number("Omega1");
-    b.Omega2 = e->optional_number("Omega2");
-    b.Omega3 = e->optional_number("Omega3");
+    e->allow(keys);
+    for (const auto& b : d.boundary) {
+      if (!e->has(b.key)) continue;
+      if (!b.requires.empty() && !e->has(b.requires)) e->fail(b.requires_message, b.key);
+      values.given[b.key] = b.array ? e->numbers(b.key, b.size) : std::vector<double>{e->number(b.key)};
+    }
   }
 }
 
+// The free beanie (the one problem not yet on the descriptor path) shares the beanie's parameters.
 void read_beanie_free(const Reader& root, Scene& s) {
-  read_beanie_parameters(root, s);
+  read_parameters(root, *find_problem("beanie"), s);
   const Reader bd = root.object("boundary");
   bd.allow({"initial", "final"});
   bd.forbid("final", "a simulation (beanie_free) starts from initial data only; remove boundary.final");
@@ -459,7 +502,7 @@ void read_continuation(const Reader& so, const json& scene, Scene& s) {
   Scene::Continuation cont;
   cont.parameter = c.string("parameter", "");
   if (cont.parameter.empty()) c.fail("missing (required): a key under parameters, e.g. \"potential.amplitude\"", "parameter");
-  const json* node = &scene.at("parameters");
+  const json* node = scene.contains("parameters") ? &scene.at("parameters") : nullptr;
   std::stringstream ss(cont.parameter);
   for (std::string k; node && std::getline(ss, k, '.');) {
     if (node->is_object() && node->contains(k))
@@ -508,18 +551,24 @@ namespace {
 // scheme: the discretization and its options. closure and constraints belong to the paper's
 // nodal windows; order to Galerkin (METHOD.md §9).
 void read_scheme(const Reader& sc, Scene& s) {
-  if (s.problem == ProblemKind::BeanieFree) {
+  if (!s.problem) {
     sc.allow({});
     return;
   }
+  const ProblemDescriptor& d = s.problem->descriptor();
   std::vector<std::string> keys = {"discretization", "order", "closure", "error_estimate"};
-  if (s.problem == ProblemKind::Beanie) keys.push_back("constraints");
+  for (const auto& o : d.paper_options) keys.push_back(o.key);
   sc.allow(keys);
   s.error_estimate = sc.boolean("error_estimate", false);
-  s.discretization =
-      sc.choice("discretization", {"paper", "galerkin"}, "paper") == "galerkin" ? Discretization::Galerkin : Discretization::Paper;
+  s.discretization = sc.choice("discretization", {"paper", "galerkin"}, s.galerkin() ? "galerkin" : "paper") == "galerkin"
+                         ? Discretization::Galerkin
+                         : Discretization::Paper;
+  if (!s.galerkin() && d.paper_order == 0)
+    sc.fail("problem \"" + d.name + "\" has only its continuous form, for the \"galerkin\" discretization", "discretization");
   if (s.galerkin()) {
-    for (const char* key : {"closure", "constraints"})
+    std::vector<std::string> paper_only = {"closure"};
+    for (const auto& o : d.paper_options) paper_only.push_back(o.key);
+    for (const auto& key : paper_only)
       if (sc.has(key))
         sc.fail("applies to the paper's discretization only (Galerkin imposes node positions and velocities exactly "
                 "and the continuous constraints at its Gauss points); remove it",
@@ -534,10 +583,7 @@ void read_scheme(const Reader& sc, Scene& s) {
             "scheme.discretization = \"galerkin\"",
             "order");
   s.closure = sc.choice("closure", {"paper", "second_order"}, "second_order") == "paper" ? Closure::Paper : Closure::SecondOrder;
-  if (s.problem == ProblemKind::Beanie)
-    s.constraints = sc.choice("constraints", {"paper", "exact_rotation"}, "exact_rotation") == "paper"
-                        ? problems::BeanieConstraints::Paper
-                        : problems::BeanieConstraints::ExactRotation;
+  for (const auto& o : d.paper_options) s.scheme_options[o.key] = sc.choice(o.key, o.choices, o.choices.front());
 }
 
 Scene parse_scene(const json& j, const std::string& path) {
@@ -547,11 +593,13 @@ Scene parse_scene(const json& j, const std::string& path) {
 
   const Reader root(j, "", path);
   root.allow({"problem", "description", "parameters", "horizon", "boundary", "scheme", "solver", "output"});
-  s.problem_name = root.choice("problem", {"electron", "beanie", "beanie_free"}, "");
-  if (s.problem_name.empty()) root.fail("missing (required): one of electron, beanie, beanie_free", "problem");
-  s.problem = s.problem_name == "electron" ? ProblemKind::Electron
-              : s.problem_name == "beanie" ? ProblemKind::Beanie
-                                           : ProblemKind::BeanieFree;
+  std::vector<std::string> names;
+  for (const Problem* p : registered_problems()) names.push_back(p->descriptor().name);
+  names.push_back("beanie_free");
+  s.problem_name = root.choice("problem", names, "");
+  if (s.problem_name.empty()) root.fail("missing (required): one of " + join(names), "problem");
+  s.problem = find_problem(s.problem_name);
+  s.k = s.problem ? s.problem->descriptor().paper_order : 1;
   root.string("description", "");
 
   const Reader hz = root.object("horizon");
@@ -561,10 +609,13 @@ Scene parse_scene(const json& j, const std::string& path) {
   if (!hz.has("N")) hz.fail("missing (required)", "N");
   s.N = hz.integer("N", 0);
 
-  switch (s.problem) {
-    case ProblemKind::Electron: read_electron(root, s); break;
-    case ProblemKind::Beanie: read_beanie(root, s); break;
-    case ProblemKind::BeanieFree: read_beanie_free(root, s); break;
+  if (s.problem) {
+    read_parameters(root, *s.problem, s);
+    read_boundary(root, s.problem->descriptor(), s);
+    if (s.problem->descriptor().paper_order == 0) s.discretization = Discretization::Galerkin;
+    for (const auto& o : s.problem->descriptor().paper_options) s.scheme_options[o.key] = o.choices.front();
+  } else {
+    read_beanie_free(root, s);
   }
 
   const auto sc = root.optional_object("scheme");
@@ -639,9 +690,6 @@ bool set_scheme(Scene& s, const std::string& name) {
 }
 
 const char* closure_name(Closure c) { return c == Closure::Paper ? "paper" : "second_order"; }
-const char* constraints_name(problems::BeanieConstraints c) {
-  return c == problems::BeanieConstraints::Paper ? "paper" : "exact_rotation";
-}
 const char* method_name(ShootingMethod m) { return m == ShootingMethod::Multiple ? "multiple" : "single"; }
 
 }  // namespace lpshoot::app

@@ -2,10 +2,15 @@
 // into typed values. Every error names the offending key and the file.
 #pragma once
 
-#include <lpshoot/problems/beanie_bvp.hpp>
-#include <lpshoot/problems/electron_bvp.hpp>
+#include "descriptor.hpp"
+
+#include <lpshoot/shooting/shooting.hpp>
+
+#include <Eigen/Core>
 
 #include <algorithm>
+#include <array>
+#include <map>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -18,7 +23,7 @@ struct SceneError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-enum class ProblemKind { Electron, Beanie, BeanieFree };
+class Problem;  // problem.hpp
 
 // scheme.discretization: the paper's nodal windows (with a closure), or Galerkin on node states
 // of order 4 or 6 (METHOD.md §9; the library has order 8 too).
@@ -34,15 +39,18 @@ struct BeanieFreeInitial {
 struct Scene {
   std::string file;           // where it was read from (for messages)
   std::string effective_json; // the scene after --set overrides and defaults, pretty-printed
-  ProblemKind problem = ProblemKind::Electron;
+  // The registered problem (problem.hpp); nullptr for the free beanie's simulation (beanie_free),
+  // the one problem not yet on the descriptor path.
+  const Problem* problem = nullptr;
   std::string problem_name;
+  int k = 2;  // the order of the paper's discretization (its windows have k + 1 nodes)
   double T = 1.0;
   int N = 100;
 
   Discretization discretization = Discretization::Paper;
   int galerkin_order = 4;  // scheme.order (Galerkin only): 4 or 6
   Closure closure = Closure::SecondOrder;
-  problems::BeanieConstraints constraints = problems::BeanieConstraints::ExactRotation;
+  std::map<std::string, std::string> scheme_options;  // the problem's own paper-scheme choices (descriptor)
   ShootingOptions shooting;
   bool auto_segments = true;
   bool error_estimate = false;  // scheme.error_estimate: also solve on N/2 and N/4 (run.cpp)
@@ -59,16 +67,13 @@ struct Scene {
   std::string out_dir;
   bool plot = true;
 
-  problems::Electron electron;
-  problems::ElectronBoundary electron_start, electron_end;
+  ParameterValues parameters;      // under "parameters", validated against the descriptor
+  BoundaryValues start, end;       // under "boundary.initial" and "boundary.final"
+  BeanieFreeInitial beanie_free;   // beanie_free only
 
-  problems::BeanieParameters beanie;
-  problems::BeanieBoundary beanie_start, beanie_end;
-  BeanieFreeInitial beanie_free;
-
-  int order() const { return problem == ProblemKind::BeanieFree ? 1 : 2; }
+  int order() const { return k; }
   double h() const { return T / N; }
-  bool is_optimal_control() const { return problem != ProblemKind::BeanieFree; }
+  bool is_optimal_control() const { return problem != nullptr; }
   bool galerkin() const { return discretization == Discretization::Galerkin; }
   // The smallest grid the scheme accepts: 2k + 1 nodes for the paper's windows, 2 intervals for Galerkin.
   int min_N() const { return galerkin() ? 2 : 2 * order() + 1; }
@@ -96,7 +101,6 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
 Scene with_parameter(const Scene& s, const std::string& parameter, double value);
 
 const char* closure_name(Closure c);
-const char* constraints_name(problems::BeanieConstraints c);
 const char* method_name(ShootingMethod m);
 
 }  // namespace lpshoot::app

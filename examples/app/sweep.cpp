@@ -39,7 +39,7 @@ SweepRecord run_sweep(const Scene& scene, const std::string& command, const Swee
   std::vector<int> grids = opt.N;
   std::sort(grids.begin(), grids.end());
   grids.erase(std::unique(grids.begin(), grids.end()), grids.end());
-  if (scene.problem == ProblemKind::BeanieFree && scene.beanie_free.configurations)
+  if (!scene.problem && scene.beanie_free.configurations)
     throw SceneError(scene.file + ": boundary.initial.configurations: q_0, q_1 belong to one grid; a sweep needs "
                                   "initial data as position and velocity");
   // The schemes (each a copy of the scene), solvers (simulations have none to choose), grids
@@ -47,9 +47,12 @@ SweepRecord run_sweep(const Scene& scene, const std::string& command, const Swee
   std::vector<Scene> schemes;
   for (const std::string& name : opt.schemes) {
     Scene sc = scene;
-    if (!scene.is_optimal_control() || !set_scheme(sc, name))
+    const bool has_paper = scene.order() > 0;  // a problem with only a continuous form has Galerkin schemes only
+    if (!scene.is_optimal_control() || !set_scheme(sc, name) || (name == "paper" && !has_paper))
       throw SceneError("--scheme: '" + name + "' is not a scheme of " + scene.problem_name +
-                       (scene.is_optimal_control() ? " (paper, galerkin4, galerkin6)" : " (a simulation has one scheme)"));
+                       (!scene.is_optimal_control() ? " (a simulation has one scheme)"
+                        : has_paper                 ? " (paper, galerkin4, galerkin6)"
+                                                    : " (galerkin4, galerkin6)"));
     schemes.push_back(sc);
   }
   if (schemes.empty()) schemes.push_back(scene);

@@ -192,11 +192,12 @@ TEST(ExampleScenes, BeanieOnTheOrderSixGalerkinScheme) {
   EXPECT_FALSE(report.contains("closure"));
   std::vector<std::string> header;
   const auto rows = read_csv(out / "trajectory.csv", header);
-  EXPECT_EQ(header, (std::vector<std::string>{"t", "psi", "theta", "x", "y", "Omega1", "Omega2", "Omega3", "psi_dot", "u"}));
+  // The generic columns (model_problem.hpp): t, shape, group coordinates, Ω, velocities, outputs.
+  EXPECT_EQ(header, (std::vector<std::string>{"t", "psi", "x", "y", "theta", "Omega1", "Omega2", "Omega3", "psi_dot", "u"}));
   // Node data are imposed exactly: Ω12(0), ψ'(T) and θ(T) to the solver's tolerance.
   EXPECT_NEAR(rows.front()[5], 0.5, 1e-10);
   EXPECT_NEAR(rows.back()[8], 0.0, 1e-9);
-  EXPECT_NEAR(rows.back()[2], 1.0, 1e-10);
+  EXPECT_NEAR(rows.back()[4], 1.0, 1e-10);
   // The control at every node (discrete Legendre transform), finite.
   for (const auto& r : rows) EXPECT_TRUE(std::isfinite(r[9]));
 }
@@ -363,6 +364,48 @@ TEST(Sweep, ElectronOrdersAgainstTheExactOptimum) {
   }
 }
 
+TEST(ModelProblems, SphericalPendulumFromOneFileSolvesAndConservesItsAngularMomentum) {
+  // Issue 10: a problem added as one file (examples/app/problem_spherical_pendulum.cpp), run by
+  // the generic path. Its azimuth is free, so m l² sin²φ Ω = P is conserved, and the azimuth
+  // turned is θ(T) - θ(0) = ∫ P / (m l² sin²φ) dt: computed here from the φ column by Simpson's
+  // rule, it must agree with the θ(T) = 1.5 the scene imposes.
+  const fs::path work = scratch("spherical_pendulum"), out = work / "out";
+  const Outcome o = run_cli("solve '" + scene("spherical_pendulum") + "' --out '" + out.string() + "'", work);
+  ASSERT_EQ(o.code, 0) << o.out << o.err;
+  const json report = json::parse(std::ifstream(out / "report.json"));
+  EXPECT_EQ(report["scheme"], "galerkin6");
+  EXPECT_LT(report["momentum_drift_relative"].get<double>(), 1e-12);
+  EXPECT_LT(report["physical_momentum_drift"].get<double>(), 1e-10);
+  std::vector<std::string> header;
+  const auto rows = read_csv(out / "trajectory.csv", header);
+  ASSERT_EQ(header, (std::vector<std::string>{"t", "phi", "theta", "Omega", "phi_dot", "u"}));
+  ASSERT_EQ(rows.size(), 41u);
+  EXPECT_NEAR(rows.back()[1], 1.0, 1e-10);
+  EXPECT_NEAR(rows.back()[2], 1.5, 1e-10);
+  const double P = report["physical_momentum_initial"][0].get<double>(), h = rows[1][0] - rows[0][0];  // m = l = 1
+  double turned = 0;
+  for (size_t n = 0; n < rows.size(); ++n) {
+    const double w = n == 0 || n + 1 == rows.size() ? 1 : n % 2 ? 4 : 2, s = std::sin(rows[n][1]);
+    turned += w * h / 3 * P / (s * s);
+  }
+  EXPECT_NEAR(turned, 1.5, 1e-5);
+  for (const auto& r : rows) EXPECT_NEAR(r[3], P / std::pow(std::sin(r[1]), 2), 1e-9);  // Ω at the nodes
+
+  // Orders 4 and 6 (METHOD.md §9) on a problem the paper does not have.
+  const Outcome sw_run = run_cli("sweep '" + scene("spherical_pendulum") + "' --N 10,20,40,80 --scheme galerkin4,galerkin6 --out '" +
+                                     (work / "sweep").string() + "'", work);
+  ASSERT_EQ(sw_run.code, 0) << sw_run.out << sw_run.err;
+  const json sw = json::parse(std::ifstream(work / "sweep" / "sweep.json"));
+  ASSERT_EQ(sw["runs"].size(), 8u);
+  for (size_t i : {1, 2, 5, 6}) EXPECT_NEAR(sw["runs"][i]["order"].get<double>(), i < 4 ? 4.0 : 6.0, 0.2) << sw["runs"][i].dump();
+
+  // No discrete form: the paper's scheme is refused, naming the key.
+  const Outcome paper = run_cli("check '" + scene("spherical_pendulum") + "' --set scheme.discretization=paper", work);
+  EXPECT_EQ(paper.code, 2);
+  EXPECT_NE(paper.err.find("scheme.discretization: problem \"spherical_pendulum\" has only its continuous form"), std::string::npos)
+      << paper.err;
+}
+
 TEST(Sweep, GalerkinSchemesReachOrdersFourAndSixAgainstTheExactOptimum) {
   // METHOD.md §9: the cubic and quartic Galerkin schemes converge at orders 4 and 6 in the node
   // positions and in the cost, to 1e-12 with no roundoff floor, where the paper's scheme is at 2.
@@ -471,6 +514,7 @@ class BadInput : public ::testing::Test {
 
 TEST_F(BadInput, EachClassFailsCleanlyNamingTheKey) {
   const std::string e = "'" + scene("electron") + "' --out OUT ", b = "'" + scene("beanie") + "' --out OUT ";
+  const std::string sp = "'" + scene("spherical_pendulum") + "' --out OUT ";
   const std::vector<BadCase> cases = {
       {"missing_file", "solve WORK/none.json --out OUT", "none.json: cannot read the scene file: no such file"},
       {"directory_scene", "solve WORK --out OUT", "cannot read the scene file: it is a directory"},
@@ -524,6 +568,14 @@ TEST_F(BadInput, EachClassFailsCleanlyNamingTheKey) {
        "horizon.N: must be at least 2 for the galerkin discretization"},
       {"galerkin_segments", "solve " + e + "--set 'scheme={\"discretization\": \"galerkin\"}' --set solver.segments=201",
        "solver.segments: must be between 1 and N = 200"},
+      // A problem from its descriptor only (issue 10): the same classes, named the same way.
+      {"model_unknown_parameter", "solve " + sp + "--set parameters.mass=2", "parameters.mass: unknown key (allowed here: m, l, g)"},
+      {"model_range", "solve " + sp + "--set parameters.g=-1", "parameters.g: must be between 0 and 1000 (got -1)"},
+      {"model_positive", "solve " + sp + "--set parameters.l=0", "parameters.l: must be > 0 (got 0)"},
+      {"model_type", "solve " + sp + "--set parameters.m=\\\"heavy\\\"", "parameters.m: must be a number"},
+      {"model_requires", "solve " + sp + "--set boundary.final.phi=null", "boundary.final.phi_dot: is given without phi"},
+      {"model_unknown_boundary", "solve " + sp + "--set boundary.final.psi=1", "boundary.final.psi: unknown key (did you mean 'boundary.final.phi'?)"},
+      {"model_closure", "solve " + sp + "--set scheme.closure=paper", "scheme.closure: applies to the paper's discretization only"},
       {"unwritable_out", "", "cannot create the directory", 3},
   };
   for (const BadCase& c : cases) {
@@ -550,7 +602,7 @@ TEST_F(BadInput, InvalidJsonNamesTheLine) {
 
 TEST_F(BadInput, CheckAcceptsEveryExampleScene) {
   const fs::path work = scratch("check");
-  for (const char* name : {"electron", "beanie", "beanie_free", "electron_unstable", "beanie_galerkin"}) {
+  for (const char* name : {"electron", "beanie", "beanie_free", "electron_unstable", "beanie_galerkin", "spherical_pendulum"}) {
     const Outcome o = run_cli(std::string("check '") + scene(name) + "'", work);
     EXPECT_EQ(o.code, 0) << name << ": " << o.err;
     EXPECT_NE(o.out.find("valid"), std::string::npos);
