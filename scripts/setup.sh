@@ -8,7 +8,7 @@ packages=(
   libeigen3-dev                      # Eigen 3.4
   libsundials-dev                    # SUNDIALS 6.4 (KINSOL)
   libnlopt-dev libnlopt-cxx-dev      # NLopt 2.7
-  libboost-dev                       # Boost 1.74 (Odeint)
+  libboost-dev                       # Boost 1.74 (Odeint; SHA-1 for the plugin cache)
   libgtest-dev libbenchmark-dev      # GoogleTest, Google Benchmark
   libcli11-dev nlohmann-json3-dev    # the application
   gnuplot-nox                        # plots

@@ -133,4 +133,14 @@ inline std::string boundary_name(const ProblemDescriptor& d, bool initial, NodeP
   return std::string(initial ? "initial " : "terminal ") + names.at(index);
 }
 
+// The number of components of each node part, in NodePart order (shape, velocity, Ω, group).
+struct PartSizes {
+  int shape, velocity, omega, group;
+};
+
+// Why a descriptor contradicts itself or its model's dimensions (a boundary entry outside its
+// part, a "requires" naming no entry, a default outside its range, a plot of an unknown column),
+// or "" (descriptor_check.cpp).
+std::string descriptor_error(const ProblemDescriptor& d, PartSizes sizes);
+
 }  // namespace lpshoot::app

@@ -4,11 +4,15 @@
 //   lpshoot sweep SCENE.json --N 50,100,200 [--scheme paper,galerkin4,galerkin6] [--method single,multiple]
 //                [--backend kinsol,nlopt]
 //   lpshoot check SCENE.json
+//   lpshoot problems [--json]
+// Every command takes --problem FILE.cpp (a problem of one's own, built once and cached; plugin.hpp).
 // Exit codes: 0 converged; 1 the run did not converge (the report says why); 2 bad command line
 // or scene; 3 the results could not be written; 4 an internal error or out of memory;
 // 130 / 143 interrupted by SIGINT / SIGTERM (the report says so).
+#include "describe.hpp"
 #include "interrupt.hpp"
 #include "output.hpp"
+#include "plugin.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -26,10 +30,26 @@ using namespace lpshoot;
 using namespace lpshoot::app;
 
 struct Common {
-  std::string scene, out;
-  std::vector<std::string> sets;
+  std::string scene, out, plugin_cache;
+  std::vector<std::string> sets, problem_files;
   bool no_plot = false, progress = false, quiet = false;
 };
+
+// Loads the --problem files (building those not cached yet); "" or the reason one failed.
+std::string load_problem_files(const Common& c) {
+  PluginOptions options;
+  options.cache_dir = c.plugin_cache;
+  if (!c.quiet) options.notify = [](const std::string& what) { std::fprintf(stderr, "lpshoot: %s\n", what.c_str()); };
+  for (const auto& file : c.problem_files) {
+    try {
+      const LoadedPlugin p = load_problem_file(file, options);
+      if (p.built && !c.quiet) std::fprintf(stderr, "lpshoot: built %s in %.1f s\n", file.c_str(), p.build_seconds);
+    } catch (const PluginError& e) {
+      return e.what();
+    }
+  }
+  return "";
+}
 
 // Progress lines go to a terminal as they come; to a log (stderr not a terminal) at most one
 // every 10 s, so a long run is visibly alive without flooding the log. Every call is also a
@@ -141,8 +161,15 @@ int run_command(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "lpshoot 0.1.0");
   Common c;
+  auto plugin_options = [&](CLI::App* sub) {
+    sub->add_option("--problem", c.problem_files, "a problem of one's own: its C++ file (built once, then cached)")
+        ->allow_extra_args(false);
+    sub->add_option("--plugin-cache", c.plugin_cache,
+                    "where built problems are cached (default: $LPSHOOT_PLUGIN_CACHE, else ~/.cache/lpshoot/plugins)");
+  };
   auto scene_options = [&](CLI::App* sub, bool outputs) {
     sub->add_option("scene", c.scene, "the scene file (JSON; see the README's scene reference)")->required();
+    plugin_options(sub);
     sub->add_option("--set", c.sets, "override a scene value, key.path=value (repeatable; value JSON or a word; null frees it)")
         ->allow_extra_args(false);
     if (!outputs) return;
@@ -155,6 +182,10 @@ int run_command(int argc, char** argv) {
   CLI::App* simulate = app.add_subcommand("simulate", "run the discrete flow from the scene's initial data");
   CLI::App* sweep = app.add_subcommand("sweep", "solve or simulate over several grids/solvers: error, order, time");
   CLI::App* check = app.add_subcommand("check", "validate the scene only");
+  CLI::App* problems = app.add_subcommand("problems", "list the problems (built-in and --problem files) and their scene keys");
+  bool problems_json_flag = false;
+  plugin_options(problems);
+  problems->add_flag("--json", problems_json_flag, "as JSON (one object per problem)");
   scene_options(solve, true);
   scene_options(simulate, true);
   scene_options(sweep, true);
@@ -185,6 +216,15 @@ int run_command(int argc, char** argv) {
   for (CLI::App* sub : {solve, simulate, sweep})
     if (sub->parsed() && sub->count("--out") > 0 && c.out.empty())
       return fail_input("--out: the output directory is empty (give a directory, or leave --out out for the scene's)");
+
+  if (const auto errors = registration_errors(); !errors.empty())
+    throw std::logic_error("a built-in problem is ill-defined: " + errors.front());
+  if (const std::string why = load_problem_files(c); !why.empty()) return fail_input(why);
+  if (problems->parsed()) {
+    const std::string text = problems_json_flag ? problems_json(registered_problems()) : problems_text(registered_problems());
+    std::fputs(text.c_str(), stdout);
+    return 0;
+  }
 
   Scene scene;
   try {

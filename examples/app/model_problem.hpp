@@ -33,12 +33,15 @@ class ModelProblem : public Problem {
     const ProblemDescriptor& D = descriptor_;
     if (static_cast<int>(D.shape.size()) != r || static_cast<int>(D.velocity.size()) != r ||
         static_cast<int>(D.group.size()) != d || static_cast<int>(D.omega.size()) != d)
-      throw std::logic_error("problem '" + D.name + "': the descriptor names " + std::to_string(D.shape.size()) +
-                             " shape, " + std::to_string(D.velocity.size()) + " velocity, " +
-                             std::to_string(D.group.size()) + " group and " + std::to_string(D.omega.size()) +
-                             " Omega components; the model has shape_dim = " + std::to_string(r) +
-                             " and a group of dimension " + std::to_string(d));
+      definition_error_ = "the descriptor names " + std::to_string(D.shape.size()) + " shape, " +
+                          std::to_string(D.velocity.size()) + " velocity, " + std::to_string(D.group.size()) +
+                          " group and " + std::to_string(D.omega.size()) +
+                          " Omega components; the model has shape_dim = " + std::to_string(r) +
+                          " and a group of dimension " + std::to_string(d);
+    else
+      definition_error_ = descriptor_error(D, {r, r, d, d});
   }
+  std::string definition_error() const override { return definition_error_; }
 
   // Optional: derived columns at each node (descriptor().outputs names them), from the node's jet.
   std::function<std::vector<double>(const Model&, const Jet<Model, double>&)> outputs;
@@ -190,6 +193,7 @@ class ModelProblem : public Problem {
 
   ProblemDescriptor descriptor_;
   std::function<Model(const ParameterValues&)> make_;
+  std::string definition_error_;
 };
 
 // Columns PREFIX1.., PREFIX_drift of momenta given at nodes 0 .. J.size()-1 (empty cells after);

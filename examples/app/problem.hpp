@@ -27,11 +27,18 @@ class Problem {
   virtual std::optional<std::pair<std::string, std::string>> check_parameters(const ParameterValues&) const {
     return std::nullopt;
   }
+  // Why the problem's own definition is wrong (e.g. a descriptor naming more components than the
+  // model has), or "". A problem with a definition error is not registered; the error is.
+  virtual std::string definition_error() const { return ""; }
 };
 
+// Registration runs in static initialisers (a built-in problem's file, or a plugin being loaded),
+// where nothing may throw: a problem that cannot be registered (a definition error, a name taken)
+// is recorded in registration_errors() instead, for the application to report.
 void register_problem(const Problem& problem);
 const Problem* find_problem(const std::string& name);
 std::vector<const Problem*> registered_problems();  // by name
+std::vector<std::string> registration_errors();
 
 struct ProblemRegistration {
   explicit ProblemRegistration(const Problem& problem) { register_problem(problem); }

@@ -7,7 +7,7 @@
 // imposed as the constraint χ = d/dt(sin²φ Ω) = sin²φ Ω' + 2 sin φ cos φ φ' Ω = 0.
 // The discrete momentum map of the scheme (J) is conserved to roundoff; the mechanical one
 // (P = m l² sin²φ Ω) to the scheme's order.
-#include "model_problem.hpp"
+#include <lpshoot/app/model_problem.hpp>
 
 #include <cmath>
 

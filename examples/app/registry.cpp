@@ -2,7 +2,6 @@
 #include "problem.hpp"
 
 #include <algorithm>
-#include <stdexcept>
 
 namespace lpshoot::app {
 namespace {
@@ -10,11 +9,26 @@ std::vector<const Problem*>& registry() {
   static std::vector<const Problem*> problems;  // filled by static registrations, before main
   return problems;
 }
+std::vector<std::string>& errors() {
+  static std::vector<std::string> e;
+  return e;
+}
 }  // namespace
 
 void register_problem(const Problem& problem) {
-  if (find_problem(problem.descriptor().name))
-    throw std::logic_error("problem '" + problem.descriptor().name + "' is registered twice");
+  const std::string& name = problem.descriptor().name;
+  if (const std::string why = problem.definition_error(); !why.empty()) {
+    errors().push_back("problem \"" + name + "\": " + why);
+    return;
+  }
+  if (name.empty()) {
+    errors().push_back("a problem without a name (set the descriptor's name)");
+    return;
+  }
+  if (find_problem(name)) {
+    errors().push_back("problem \"" + name + "\" is registered twice (problem names must be unique)");
+    return;
+  }
   auto& r = registry();
   r.push_back(&problem);
   std::sort(r.begin(), r.end(), [](const Problem* a, const Problem* b) { return a->descriptor().name < b->descriptor().name; });
@@ -27,5 +41,7 @@ const Problem* find_problem(const std::string& name) {
 }
 
 std::vector<const Problem*> registered_problems() { return registry(); }
+
+std::vector<std::string> registration_errors() { return errors(); }
 
 }  // namespace lpshoot::app

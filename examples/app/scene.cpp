@@ -596,8 +596,12 @@ Scene parse_scene(const json& j, const std::string& path) {
   std::vector<std::string> names;
   for (const Problem* p : registered_problems()) names.push_back(p->descriptor().name);
   names.push_back("beanie_free");
+  if (!root.has("problem")) root.fail("missing (required): one of " + join(names), "problem");
+  if (const json& p = root.at("problem"); p.is_string() && std::find(names.begin(), names.end(), p) == names.end())
+    root.fail("unknown problem " + p.dump() + ": the registered problems are " + join(names) +
+                  "; a problem of one's own is loaded from its C++ file with --problem FILE.cpp",
+              "problem");
   s.problem_name = root.choice("problem", names, "");
-  if (s.problem_name.empty()) root.fail("missing (required): one of " + join(names), "problem");
   s.problem = find_problem(s.problem_name);
   s.k = s.problem ? s.problem->descriptor().paper_order : 1;
   root.string("description", "");

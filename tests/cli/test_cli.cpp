@@ -1,94 +1,15 @@
 // The lpshoot application end to end: the example scenes against their stored answers and
 // against the exact electron optimum, sweeps and their observed orders, failed runs that say so,
 // and one test per class of bad input (clean message naming the key, exit code 2, no output).
+#include "cli_helpers.hpp"
+
 #include <lpshoot/problems/electron_exact.hpp>
 
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-
-#include <sys/wait.h>
-
 #include <algorithm>
-#include <cmath>
-#include <cstdlib>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
 
-namespace fs = std::filesystem;
-using json = nlohmann::json;
+using namespace lpshoot_cli_test;
 
 namespace {
-
-struct Outcome {
-  int code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
-fs::path scratch(const std::string& name) {
-  const fs::path d = fs::path(::testing::TempDir()) / ("lpshoot_cli_" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-// Runs `lpshoot ARGS` with stdout and stderr captured.
-Outcome run_cli(const std::string& args, const fs::path& work) {
-  const std::string cmd = std::string("'") + LPSHOOT_CLI + "' " + args + " > '" + (work / "stdout").string() + "' 2> '" +
-                          (work / "stderr").string() + "'";
-  const int rc = std::system(cmd.c_str());
-  return {rc == -1 ? -1 : WEXITSTATUS(rc), slurp(work / "stdout"), slurp(work / "stderr")};
-}
-
-std::string scene(const std::string& name) { return std::string(LPSHOOT_SCENES) + "/" + name + ".json"; }
-
-const json* at_path(const json& j, const std::string& dotted) {
-  const json* node = &j;
-  std::stringstream ss(dotted);
-  for (std::string k; std::getline(ss, k, '.');) {
-    if (!node->is_object() || !node->contains(k)) return nullptr;
-    node = &(*node)[k];
-  }
-  return node;
-}
-
-bool gnuplot_available() { return std::system("command -v gnuplot > /dev/null 2>&1") == 0; }
-
-bool is_png(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  char magic[8] = {};
-  f.read(magic, 8);
-  return f && std::string(magic + 1, 3) == "PNG";
-}
-
-// Rows of a CSV with a header; empty cells are NaN.
-std::vector<std::vector<double>> read_csv(const fs::path& p, std::vector<std::string>& header) {
-  std::ifstream f(p);
-  std::string line;
-  std::getline(f, line);
-  header.clear();
-  std::stringstream hs(line);
-  for (std::string c; std::getline(hs, c, ',');) header.push_back(c);
-  std::vector<std::vector<double>> rows;
-  while (std::getline(f, line)) {
-    std::vector<double> row;
-    std::stringstream ls(line);
-    std::string c;
-    for (size_t i = 0; i < header.size(); ++i) {
-      std::getline(ls, c, ',');
-      row.push_back(c.empty() ? std::nan("") : std::stod(c));
-    }
-    rows.push_back(row);
-  }
-  return rows;
-}
 
 // Runs an example scene and compares its report with examples/scenes/expected/NAME.json.
 json run_example(const std::string& name, const fs::path& out) {
