@@ -90,8 +90,15 @@ std::string package_directory() {
                     tried + " (install lpshoot with `cmake --install`, or run it from its build tree)");
 }
 
-// Runs argv with stdout and stderr appended to `log`; the exit status (-1: could not start).
+// Runs argv with stdout and stderr appended to `log` (after the command line itself); the exit
+// status (-1: could not start).
 int run(const std::vector<std::string>& argv, const std::string& log) {
+  {
+    std::ofstream l(log, std::ios::app);
+    l << "$";
+    for (const auto& a : argv) l << " " << a;
+    l << "\n";
+  }
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);

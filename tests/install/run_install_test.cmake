@@ -49,3 +49,23 @@ if(NOT example)
 endif()
 step("run the example" "${example}")
 message("${step_output}")
+
+# (e) the installed application builds a problem of one's own against the installed package (its
+# build log names the prefix's package, not the build tree's) and solves it. Skipped in a checked build (its plugin would need the sanitizer runtimes loaded
+# into a non-instrumented host).
+if(NOT SANITIZE)
+  set(plugin_cache "${BUILD_DIR}/install-test-plugins")
+  file(REMOVE_RECURSE "${plugin_cache}")
+  execute_process(COMMAND "${prefix}/bin/lpshoot" solve --problem "${PLUGIN_SOURCE}" --plugin-cache "${plugin_cache}"
+                          "${PLUGIN_SCENE}" --no-plot --out "${plugin_cache}/out"
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out)
+  if(NOT rc EQUAL 0 OR NOT out MATCHES "status: converged")
+    message(FATAL_ERROR "the installed lpshoot with --problem ${PLUGIN_SOURCE} failed (${rc}):\n${out}")
+  endif()
+  file(GLOB built "${plugin_cache}/*/build.log")
+  file(READ "${built}" log)
+  if(NOT log MATCHES "lpshoot_DIR=${prefix}/")
+    message(FATAL_ERROR "the plugin was not built against the installed package ${prefix}:\n${log}")
+  endif()
+  message(STATUS "the installed lpshoot solves a problem of one's own: ok")
+endif()
