@@ -41,6 +41,7 @@ std::string range_text(const ParameterSpec& p) {
 }
 
 std::vector<std::string> schemes(const ProblemDescriptor& d) {
+  if (!d.optimal_control) return {"paper"};  // a free motion: the paper's windows only
   std::vector<std::string> s;
   if (d.paper_order > 0) s.push_back("paper");
   s.push_back("galerkin4");
@@ -71,6 +72,8 @@ json describe(const ProblemDescriptor& d) {
     boundary.push_back(e);
   }
   j["boundary"] = boundary;
+  j["command"] = d.optimal_control ? "solve" : "simulate";
+  if (!d.optimal_control) j["configuration"] = d.configuration;
   j["columns"] = {{"shape", d.shape}, {"velocity", d.velocity}, {"group", d.group}, {"omega", d.omega}, {"outputs", d.outputs}};
   j["schemes"] = schemes(d);
   if (d.paper_order > 0) j["paper_order"] = d.paper_order;
@@ -92,7 +95,7 @@ std::string problems_text(const std::vector<const Problem*>& problems) {
     out += d.name + ": " + d.summary + "\n";
     std::string sc;
     for (const auto& s : schemes(d)) sc += (sc.empty() ? "" : ", ") + s;
-    out += "  schemes: " + sc + "\n";
+    out += "  " + std::string(d.optimal_control ? "solve" : "simulate") + ", schemes: " + sc + "\n";
     if (!d.parameters.empty()) out += "  parameters:\n";
     for (const auto& q : d.parameters) {
       std::string def;
@@ -113,6 +116,12 @@ std::string problems_text(const std::vector<const Problem*>& problems) {
              part_name(b.part);
       if (!b.requires.empty()) out += ", requires " + b.requires;
       out += "\n";
+    }
+    if (!d.configuration.empty()) {
+      std::string q;
+      for (const auto& c : d.configuration) q += (q.empty() ? "[" : ", ") + c;
+      q += "]";
+      out += "  initial data (under boundary.initial): configurations [q_0, q_1], or position and velocity; q = " + q + "\n";
     }
     std::string cols = "t";
     for (const auto* names : {&d.shape, &d.group, &d.omega, &d.velocity, &d.outputs})

@@ -1,6 +1,6 @@
 // A problem descriptor (issue 10): what the application needs to know about a problem to read
 // its scenes, name its outputs and plot them, stated next to the problem's struct in plain C++.
-// The scene reader (scene_problem.cpp) validates "parameters" and "boundary" against it; the
+// The scene reader (scene.cpp) validates "parameters" and "boundary" against it; the
 // runner (model_problem.hpp) names the trajectory's columns from it.
 #pragma once
 
@@ -85,6 +85,13 @@ struct ProblemDescriptor {
   // 0 when the problem has only the continuous form (Galerkin schemes only).
   int paper_order = 0;
   std::vector<SchemeOption> paper_options;
+  // false: a free motion from initial data (`lpshoot simulate`, the paper's windows of order
+  // paper_order) rather than an optimal control problem (`lpshoot solve`).
+  bool optimal_control = true;
+  // A free motion's initial data: the names of its configuration coordinates. Under
+  // boundary.initial the scene gives configurations [q_0, q_1], or position and velocity
+  // (q_1 = q_0 + h q'(0), the paper's first-order closure), each with these components.
+  std::vector<std::string> configuration;
 };
 
 // A scene's parameters, validated: every key of the descriptor has a value (default or given).

@@ -121,11 +121,8 @@ std::string lines(const std::string& file, const std::string& x, const std::stri
 }
 
 // The panels of trajectory.png: the descriptor's, or its shape, group coordinates and outputs
-// against t; the free beanie's plane path, shape and orientation and body velocity.
+// against t.
 std::vector<PlotPanel> plot_panels(const Scene& scene) {
-  if (!scene.problem)
-    return {{"plane path", "x", {"y"}, true}, {"shape and orientation", "t", {"psi", "theta"}, false},
-            {"body velocity", "t", {"Omega1", "Omega2", "Omega3"}, false}};
   const ProblemDescriptor& d = scene.problem->descriptor();
   if (!d.plots.empty()) return d.plots;
   std::vector<PlotPanel> panels = {{"shape", "t", d.shape, false}};

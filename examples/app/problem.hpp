@@ -18,6 +18,10 @@ class Problem {
   virtual const ProblemDescriptor& descriptor() const = 0;
   // The scene's boundary value problem, solved on the scene's scheme.
   virtual RunRecord solve(const Scene& s, const Progress& progress) const = 0;
+  // A free motion (descriptor().optimal_control false): the scene's initial data stepped N times.
+  virtual RunRecord simulate(const Scene& s, const Progress&) const {
+    throw SceneError(s.file + ": problem \"" + descriptor().name + "\" has no free-motion form to simulate");
+  }
   // Why the scene's boundary conditions are ill-posed by counting (METHOD.md §5), or "".
   virtual std::string check_boundary(const Scene& s) const = 0;
   // The exact continuous answer at `times`, where the problem has one.

@@ -1,5 +1,4 @@
 // Which runner a command and a scene call for.
-#include "paper_problems.hpp"
 #include "problem.hpp"
 #include "run.hpp"
 
@@ -9,23 +8,24 @@
 
 namespace lpshoot::app {
 
-std::string check_boundary(const Scene& s) { return s.problem ? s.problem->check_boundary(s) : ""; }
+std::string check_boundary(const Scene& s) { return s.problem->check_boundary(s); }
 
 ExactReference exact_reference(const Scene& s, const std::vector<double>& times) {
-  return s.problem ? s.problem->exact_reference(s, times) : ExactReference();
+  return s.problem->exact_reference(s, times);
 }
 
 namespace {
 
 RunRecord run_one(const std::string& command, const Scene& s, const Progress& progress) {
   if (command == "simulate") {
-    if (s.problem)
+    if (s.is_optimal_control())
       throw SceneError(s.file + ": problem: \"" + s.problem_name +
                        "\" is an optimal control problem (a boundary value problem): run `lpshoot solve` on it");
-    return simulate_beanie_free(s, progress);
+    return s.problem->simulate(s, progress);
   }
-  if (!s.problem)
-    throw SceneError(s.file + ": problem: \"beanie_free\" is a simulation from initial data: run `lpshoot simulate` on it");
+  if (!s.is_optimal_control())
+    throw SceneError(s.file + ": problem: \"" + s.problem_name +
+                     "\" is a simulation from initial data: run `lpshoot simulate` on it");
   return s.problem->solve(s, progress);
 }
 

@@ -14,13 +14,13 @@ RunRecord simulate_beanie_free(const Scene& s, const Progress& progress) {
   BeanieFree problem;
   problem.par = beanie_parameters(s.parameters);
   const double h = s.h();
-  Eigen::Vector4d q0, q1;
-  if (s.beanie_free.configurations) {
-    q0 = (*s.beanie_free.configurations)[0];
-    q1 = (*s.beanie_free.configurations)[1];
+  Eigen::Vector4d q0, q1;  // (x, y, θ, ψ), the descriptor's configuration (problem_beanie_free.cpp)
+  if (s.initial.configurations) {
+    q0 = (*s.initial.configurations)[0];
+    q1 = (*s.initial.configurations)[1];
   } else {  // q_1 = q_0 + h q'(0)
-    q0 = s.beanie_free.position;
-    q1 = q0 + h * s.beanie_free.velocity;
+    q0 = s.initial.position;
+    q1 = q0 + h * s.initial.velocity;
   }
   FlowState<BeanieFree> init;
   init.p = {Vec<double, 1>(q0(3)), Vec<double, 1>(q1(3))};

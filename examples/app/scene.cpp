@@ -340,7 +340,7 @@ void apply_override(json& scene, const std::string& assignment) {
 ShootingMethod read_method(const std::string& s) { return s == "multiple" ? ShootingMethod::Multiple : ShootingMethod::Single; }
 
 void read_solver(const Reader& r, Scene& s) {
-  if (!s.problem) {  // a simulation: only the per-step Newton is tuned
+  if (!s.is_optimal_control()) {  // a simulation: only the per-step Newton is tuned
     r.allow({"tolerance", "max_iterations"});
     s.shooting.step.step_tolerance = r.positive("tolerance", s.shooting.step.step_tolerance);
     // A relative Newton correction per step: above 1e-6 a step is not solved to an accuracy worth
@@ -470,26 +470,33 @@ void read_boundary(const Reader& root, const ProblemDescriptor& d, Scene& s) {
   }
 }
 
-// The free beanie (the one problem not yet on the descriptor path) shares the beanie's parameters.
-void read_beanie_free(const Reader& root, Scene& s) {
-  read_parameters(root, *find_problem("beanie"), s);
+// A free motion's initial data (descriptor.configuration names its components).
+void read_initial_data(const Reader& root, const ProblemDescriptor& d, Scene& s) {
+  const size_t n = d.configuration.size();
+  std::string q = "[";
+  for (size_t i = 0; i < n; ++i) q += (i ? ", " : "") + d.configuration[i];
+  q += "]";
   const Reader bd = root.object("boundary");
   bd.allow({"initial", "final"});
-  bd.forbid("final", "a simulation (beanie_free) starts from initial data only; remove boundary.final");
+  bd.forbid("final", "a simulation (" + d.name + ") starts from initial data only; remove boundary.final");
   const Reader init = bd.object("initial");
   init.allow({"configurations", "position", "velocity"});
+  auto as_vector = [](const std::vector<double>& x) { return Eigen::Map<const Eigen::VectorXd>(x.data(), x.size()).eval(); };
+  s.initial = {};
   if (init.has("configurations")) {
     if (init.has("position") || init.has("velocity"))
       init.fail("give either configurations or position and velocity, not both", "configurations");
     const json& c = init.at("configurations");
-    if (!c.is_array() || c.size() != 2)
-      init.fail("must be [[x, y, theta, psi], [x, y, theta, psi]] (q_0 and q_1)", "configurations");
-    s.beanie_free.configurations = std::array<Eigen::Vector4d, 2>{
-        init.vector_of<4>(c[0], init.name("configurations") + "[0]"),
-        init.vector_of<4>(c[1], init.name("configurations") + "[1]")};
+    if (!c.is_array() || c.size() != 2) init.fail("must be [" + q + ", " + q + "] (q_0 and q_1)", "configurations");
+    const json rows{{"configurations[0]", c[0]}, {"configurations[1]", c[1]}};  // named as the scene's entries
+    const Reader r(rows, bd.name("initial"), s.file);
+    s.initial.configurations =
+        std::array<Eigen::VectorXd, 2>{as_vector(r.numbers("configurations[0]", n)), as_vector(r.numbers("configurations[1]", n))};
   } else {
-    s.beanie_free.position = init.vector<4>("position");
-    s.beanie_free.velocity = init.vector<4>("velocity");
+    if (!init.has("position")) init.fail("missing (required): " + q + ", or give configurations", "position");
+    if (!init.has("velocity")) init.fail("missing (required): the rates of " + q, "velocity");
+    s.initial.position = as_vector(init.numbers("position", n));
+    s.initial.velocity = as_vector(init.numbers("velocity", n));
   }
 }
 
@@ -551,7 +558,7 @@ namespace {
 // scheme: the discretization and its options. closure and constraints belong to the paper's
 // nodal windows; order to Galerkin (METHOD.md §9).
 void read_scheme(const Reader& sc, Scene& s) {
-  if (!s.problem) {
+  if (!s.is_optimal_control()) {
     sc.allow({});
     return;
   }
@@ -595,7 +602,6 @@ Scene parse_scene(const json& j, const std::string& path) {
   root.allow({"problem", "description", "parameters", "horizon", "boundary", "scheme", "solver", "output"});
   std::vector<std::string> names;
   for (const Problem* p : registered_problems()) names.push_back(p->descriptor().name);
-  names.push_back("beanie_free");
   if (!root.has("problem")) root.fail("missing (required): one of " + join(names), "problem");
   if (const json& p = root.at("problem"); p.is_string() && std::find(names.begin(), names.end(), p) == names.end())
     root.fail("unknown problem " + p.dump() + ": the registered problems are " + join(names) +
@@ -603,7 +609,7 @@ Scene parse_scene(const json& j, const std::string& path) {
               "problem");
   s.problem_name = root.choice("problem", names, "");
   s.problem = find_problem(s.problem_name);
-  s.k = s.problem ? s.problem->descriptor().paper_order : 1;
+  s.k = s.problem->descriptor().paper_order;
   root.string("description", "");
 
   const Reader hz = root.object("horizon");
@@ -613,13 +619,13 @@ Scene parse_scene(const json& j, const std::string& path) {
   if (!hz.has("N")) hz.fail("missing (required)", "N");
   s.N = hz.integer("N", 0);
 
-  if (s.problem) {
-    read_parameters(root, *s.problem, s);
+  read_parameters(root, *s.problem, s);
+  if (s.is_optimal_control()) {
     read_boundary(root, s.problem->descriptor(), s);
     if (s.problem->descriptor().paper_order == 0) s.discretization = Discretization::Galerkin;
     for (const auto& o : s.problem->descriptor().paper_options) s.scheme_options[o.key] = o.choices.front();
   } else {
-    read_beanie_free(root, s);
+    read_initial_data(root, s.problem->descriptor(), s);
   }
 
   const auto sc = root.optional_object("scheme");
@@ -692,6 +698,8 @@ bool set_scheme(Scene& s, const std::string& name) {
     }
   return false;
 }
+
+bool Scene::is_optimal_control() const { return !problem || problem->descriptor().optimal_control; }
 
 const char* closure_name(Closure c) { return c == Closure::Paper ? "paper" : "second_order"; }
 const char* method_name(ShootingMethod m) { return m == ShootingMethod::Multiple ? "multiple" : "single"; }

@@ -29,19 +29,17 @@ class Problem;  // problem.hpp
 // of order 4 or 6 (METHOD.md §9; the library has order 8 too).
 enum class Discretization { Paper, Galerkin };
 
-// Free-motion beanie initial data: q_0, q_1 directly, or a position and velocity
-// (q_1 = q_0 + h q'(0), the paper's first-order closure).
-struct BeanieFreeInitial {
-  std::optional<std::array<Eigen::Vector4d, 2>> configurations;  // (x, y, θ, ψ) at nodes 0, 1
-  Eigen::Vector4d position = Eigen::Vector4d::Zero(), velocity = Eigen::Vector4d::Zero();
+// A free motion's initial data (descriptor.configuration names the components): q_0, q_1
+// directly, or a position and velocity (q_1 = q_0 + h q'(0), the paper's first-order closure).
+struct InitialData {
+  std::optional<std::array<Eigen::VectorXd, 2>> configurations;  // at nodes 0 and 1
+  Eigen::VectorXd position, velocity;
 };
 
 struct Scene {
   std::string file;           // where it was read from (for messages)
   std::string effective_json; // the scene after --set overrides and defaults, pretty-printed
-  // The registered problem (problem.hpp); nullptr for the free beanie's simulation (beanie_free),
-  // the one problem not yet on the descriptor path.
-  const Problem* problem = nullptr;
+  const Problem* problem = nullptr;  // the registered problem (problem.hpp), never null once read
   std::string problem_name;
   int k = 2;  // the order of the paper's discretization (its windows have k + 1 nodes)
   double T = 1.0;
@@ -69,11 +67,11 @@ struct Scene {
 
   ParameterValues parameters;      // under "parameters", validated against the descriptor
   BoundaryValues start, end;       // under "boundary.initial" and "boundary.final"
-  BeanieFreeInitial beanie_free;   // beanie_free only
+  InitialData initial;             // a free motion's initial data (under "boundary.initial")
 
   int order() const { return k; }
   double h() const { return T / N; }
-  bool is_optimal_control() const { return problem != nullptr; }
+  bool is_optimal_control() const;  // the problem is solved, not simulated
   bool galerkin() const { return discretization == Discretization::Galerkin; }
   // The smallest grid the scheme accepts: 2k + 1 nodes for the paper's windows, 2 intervals for Galerkin.
   int min_N() const { return galerkin() ? 2 : 2 * order() + 1; }

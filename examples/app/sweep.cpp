@@ -39,7 +39,7 @@ SweepRecord run_sweep(const Scene& scene, const std::string& command, const Swee
   std::vector<int> grids = opt.N;
   std::sort(grids.begin(), grids.end());
   grids.erase(std::unique(grids.begin(), grids.end()), grids.end());
-  if (!scene.problem && scene.beanie_free.configurations)
+  if (!scene.is_optimal_control() && scene.initial.configurations)
     throw SceneError(scene.file + ": boundary.initial.configurations: q_0, q_1 belong to one grid; a sweep needs "
                                   "initial data as position and velocity");
   // The schemes (each a copy of the scene), solvers (simulations have none to choose), grids

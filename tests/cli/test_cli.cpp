@@ -6,6 +6,8 @@
 #include <lpshoot/problems/electron_exact.hpp>
 
 #include <algorithm>
+#include <map>
+#include <set>
 
 using namespace lpshoot_cli_test;
 
@@ -528,4 +530,49 @@ TEST_F(BadInput, CheckAcceptsEveryExampleScene) {
     EXPECT_EQ(o.code, 0) << name << ": " << o.err;
     EXPECT_NE(o.out.find("valid"), std::string::npos);
   }
+}
+
+// `lpshoot problems --json` describes every registered problem from its descriptor, and what it
+// says holds: each listed range is the one the scene reader enforces (a value just outside it is
+// rejected naming the key), and the free beanie is listed as a simulation with its initial data.
+TEST(Problems, ListingMatchesWhatTheSceneReaderEnforces) {
+  const fs::path work = scratch("problems_listing");
+  const Outcome o = run_cli("problems --json", work);
+  ASSERT_EQ(o.code, 0) << o.err;
+  const json listed = json::parse(o.out);
+  const std::map<std::string, std::string> scenes = {{"electron", "electron"},
+                                                     {"beanie", "beanie"},
+                                                     {"beanie_free", "beanie_free"},
+                                                     {"spherical_pendulum", "spherical_pendulum"}};
+  std::set<std::string> names;
+  for (const auto& p : listed) names.insert(p["name"].get<std::string>());
+  for (const auto& [name, file] : scenes) EXPECT_TRUE(names.count(name)) << name << " is not listed";
+  int checked = 0;
+  for (const auto& p : listed) {
+    const std::string name = p["name"];
+    if (!scenes.count(name)) continue;
+    if (name == "beanie_free") {
+      EXPECT_EQ(p["command"], "simulate");
+      EXPECT_EQ(p["configuration"], json({"x", "y", "theta", "psi"}));
+    } else {
+      EXPECT_EQ(p["command"], "solve");
+    }
+    for (const auto& q : p["parameters"]) {
+      if (!q.contains("min") || q["kind"] != "number") continue;
+      const double below = q["min_exclusive"].get<bool>() ? q["min"].get<double>() : q["min"].get<double>() - 1;
+      const std::string key = "parameters." + q["key"].get<std::string>();
+      const Outcome bad = run_cli("check '" + scene(scenes.at(name)) + "' --set " + key + "=" + std::to_string(below), work);
+      EXPECT_EQ(bad.code, 2) << name << " " << key << " = " << below;
+      EXPECT_NE(bad.err.find(key), std::string::npos) << bad.err;
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 8);
+  // The commands are not interchangeable, and say which one to use.
+  const Outcome sim = run_cli("simulate '" + scene("beanie") + "'", work);
+  EXPECT_EQ(sim.code, 2);
+  EXPECT_NE(sim.err.find("lpshoot solve"), std::string::npos) << sim.err;
+  const Outcome sol = run_cli("solve '" + scene("beanie_free") + "'", work);
+  EXPECT_EQ(sol.code, 2);
+  EXPECT_NE(sol.err.find("lpshoot simulate"), std::string::npos) << sol.err;
 }
