@@ -12,16 +12,6 @@ namespace {
 
 using json = nlohmann::ordered_json;
 
-const char* part_name(NodePart p) {
-  switch (p) {
-    case NodePart::Shape: return "shape";
-    case NodePart::Velocity: return "velocity";
-    case NodePart::Omega: return "Omega";
-    case NodePart::Group: return "group";
-  }
-  return "";
-}
-
 const char* kind_name(ParameterSpec::Kind k) {
   return k == ParameterSpec::Kind::Number ? "number" : k == ParameterSpec::Kind::Array ? "array" : "choice";
 }
@@ -67,7 +57,7 @@ json describe(const ProblemDescriptor& d) {
   j["parameters"] = params;
   json boundary = json::array();
   for (const auto& b : d.boundary) {
-    json e{{"key", b.key}, {"part", part_name(b.part)}, {"first", b.first}, {"size", b.size}, {"array", b.array}};
+    json e{{"key", b.key}, {"part", node_part_name(b.part)}, {"first", b.first}, {"size", b.size}, {"array", b.array}};
     if (!b.requires.empty()) e["requires"] = b.requires;
     boundary.push_back(e);
   }
@@ -113,7 +103,7 @@ std::string problems_text(const std::vector<const Problem*>& problems) {
     if (!d.boundary.empty()) out += "  boundary (under boundary.initial and boundary.final; missing = free):\n";
     for (const auto& b : d.boundary) {
       out += "    " + b.key + ": " + (b.array ? "array of " + std::to_string(b.size) : std::string("number")) + ", " +
-             part_name(b.part);
+             node_part_name(b.part);
       if (!b.requires.empty()) out += ", requires " + b.requires;
       out += "\n";
     }

@@ -46,6 +46,7 @@ inline ParameterSpec choice_parameter(std::string key, std::vector<std::string> 
 // velocities p', the reduced group velocity Ω and the group element g (in its natural
 // coordinates, group_coordinates.hpp).
 enum class NodePart { Shape, Velocity, Omega, Group };
+const char* node_part_name(NodePart part);  // "shape", "velocity", "Omega", "group" (descriptor_check.cpp)
 
 // One entry under "boundary.initial" / "boundary.final": `size` consecutive components of one
 // part of the end node's data, a number when size is 1, else an array. A missing entry is free

@@ -19,16 +19,6 @@ int part_size(NodePart part, PartSizes n) {
   return 0;
 }
 
-const char* part_name(NodePart part) {
-  switch (part) {
-    case NodePart::Shape: return "shape";
-    case NodePart::Velocity: return "velocity";
-    case NodePart::Omega: return "Omega";
-    case NodePart::Group: return "group";
-  }
-  return "";
-}
-
 std::string parameter_error(const ParameterSpec& p) {
   const std::string where = "parameter \"" + p.key + "\": ";
   if (p.key.empty() || p.key.front() == '.' || p.key.back() == '.') return "a parameter with an empty key";
@@ -52,6 +42,16 @@ std::string parameter_error(const ParameterSpec& p) {
 
 }  // namespace
 
+const char* node_part_name(NodePart part) {
+  switch (part) {
+    case NodePart::Shape: return "shape";
+    case NodePart::Velocity: return "velocity";
+    case NodePart::Omega: return "Omega";
+    case NodePart::Group: return "group";
+  }
+  return "";
+}
+
 std::string descriptor_error(const ProblemDescriptor& d, PartSizes sizes) {
   std::set<std::string> keys;
   for (const auto& p : d.parameters) {
@@ -66,7 +66,7 @@ std::string descriptor_error(const ProblemDescriptor& d, PartSizes sizes) {
     const int n = part_size(b.part, sizes);
     if (b.size < 1 || b.first < 0 || b.first + b.size > n)
       return where + "components " + std::to_string(b.first) + ".." + std::to_string(b.first + b.size - 1) +
-             " of the " + part_name(b.part) + " part, which has " + std::to_string(n) + " component(s)";
+             " of the " + node_part_name(b.part) + " part, which has " + std::to_string(n) + " component(s)";
     if (!b.array && b.size != 1) return where + "a scalar entry (array = false) must cover exactly one component";
   }
   for (const auto& b : d.boundary)

@@ -43,6 +43,17 @@ class ModelProblem : public Problem {
   }
   std::string definition_error() const override { return definition_error_; }
 
+  // Why the boundary value problem `make()` forms is ill-posed by counting, or why it cannot be
+  // formed at all (its constructor's invalid_argument), or "".
+  template <class MakeBVP>
+  static std::string counting_error(MakeBVP&& make) {
+    try {
+      return check_counting(make());
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+  }
+
   // Optional: derived columns at each node (descriptor().outputs names them), from the node's jet.
   std::function<std::vector<double>(const Model&, const Jet<Model, double>&)> outputs;
   // Optional: the mechanical system's own spatial momentum along the motion (columns P1..Pd), from
@@ -62,11 +73,7 @@ class ModelProblem : public Problem {
 
   std::string check_boundary(const Scene& s) const override {
     if (!s.galerkin()) return check_paper(s);
-    try {
-      return check_counting(boundary_value_problem<3>(s));  // counting does not depend on the degree
-    } catch (const std::invalid_argument& e) {
-      return e.what();
-    }
+    return counting_error([&] { return boundary_value_problem<3>(s); });  // counting does not depend on the degree
   }
 
   // The scene's boundary data as conditions on the end nodes: a given component is fixed, a

@@ -77,11 +77,8 @@ class BeanieProblem : public ModelProblem<problems::BeanieModel> {
     problems::BeanieControl b;
     b.par = beanie_parameters(s.parameters);
     b.variant = beanie_constraints(s);
-    try {
-      return check_counting(problems::beanie_bvp(b, s.T, s.N, beanie_boundary(s.start), beanie_boundary(s.end), s.closure));
-    } catch (const std::invalid_argument& e) {
-      return e.what();
-    }
+    return counting_error(
+        [&] { return problems::beanie_bvp(b, s.T, s.N, beanie_boundary(s.start), beanie_boundary(s.end), s.closure); });
   }
 };
 

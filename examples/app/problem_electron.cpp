@@ -48,12 +48,10 @@ class ElectronProblem : public ModelProblem<problems::ElectronModel> {
  protected:
   RunRecord solve_paper(const Scene& s, const Progress& progress) const override { return solve_electron(s, progress); }
   std::string check_paper(const Scene& s) const override {
-    try {
-      return check_counting(problems::electron_bvp(electron_of(s.parameters), s.T, s.N, electron_boundary(s.start),
-                                                   electron_boundary(s.end), s.closure));
-    } catch (const std::invalid_argument& e) {
-      return e.what();
-    }
+    return counting_error([&] {
+      return problems::electron_bvp(electron_of(s.parameters), s.T, s.N, electron_boundary(s.start),
+                                    electron_boundary(s.end), s.closure);
+    });
   }
 };
 
