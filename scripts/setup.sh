@@ -13,6 +13,9 @@ packages=(
   libcli11-dev nlohmann-json3-dev    # the application
   gnuplot-nox                        # plots
   python3                            # the CLI fuzz test (standard library only)
+  python3-dev python3-numpy pybind11-dev   # the Python module
+  python3-pytest python3-matplotlib        # its tests and examples
+  libopenmpi-dev openmpi-bin         # lpshoot study under mpirun
 )
 
 missing=()

@@ -1,23 +1,17 @@
-// Writing results (nlohmann-json stays here and in scene.cpp).
+// Writing results: the files of a run or a sweep (their JSON comes from report.cpp).
 #include "output.hpp"
+
+#include "gnuplot.hpp"
+#include "report.hpp"
 
 #include <nlohmann/json.hpp>
 
-#include "interrupt.hpp"
 #include "problem.hpp"
-
-#include <fcntl.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cerrno>
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 
 namespace lpshoot::app {
@@ -44,77 +38,8 @@ std::string csv(const Table& t) {
   return s;
 }
 
-json finite_or_null(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
-
 // Pretty JSON; text that is not UTF-8 (a file name from the command line) is written with U+FFFD.
 std::string dump(const json& j) { return j.dump(2, ' ', false, json::error_handler_t::replace) + "\n"; }
-
-// True when FILE is a whole PNG (it ends with the IEND chunk): a full disk can leave a
-// truncated image behind a gnuplot that exits 0.
-bool complete_png(const fs::path& file) {
-  std::ifstream f(file, std::ios::binary | std::ios::ate);
-  if (!f || f.tellg() < 20) return false;
-  f.seekg(-8, std::ios::end);
-  char tail[8];
-  f.read(tail, 8);
-  return f && std::string(tail, 4) == "IEND";
-}
-
-// Runs gnuplot on plot.gp in the staging directory (which writes the PNGs there). gnuplot runs
-// as a child that SIGINT/SIGTERM reach (std::system would make this process ignore them).
-void run_gnuplot(OutputDir& out, const std::string& script, const std::vector<std::string>& pngs, Written& w) {
-  out.write("plot.gp", script);
-  w.files.push_back(out.final_path("plot.gp"));
-  const fs::path log = out.staging() / ".gnuplot.log";
-  const pid_t pid = fork();
-  if (pid == 0) {
-    if (chdir(out.staging().c_str()) != 0) _exit(126);
-    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (fd >= 0) dup2(fd, 1), dup2(fd, 2);
-    execlp("gnuplot", "gnuplot", "plot.gp", static_cast<char*>(nullptr));
-    _exit(127);
-  }
-  int status = 0;
-  bool waited = pid > 0;
-  while (waited && waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) {
-      waited = false;
-      break;
-    }
-    if (interrupt_signal()) kill(pid, SIGTERM);  // then reap it
-  }
-  throw_if_interrupted();
-  const int code = !waited ? -1 : WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  std::string first_line;
-  {
-    std::ifstream f(log);
-    std::getline(f, first_line);
-  }
-  std::error_code ec;
-  fs::remove(log, ec);
-  if (code != 0) {
-    std::string why = code == 127 ? "gnuplot is not installed (apt-get install gnuplot-nox)" : "gnuplot failed";
-    if (code != 127 && !first_line.empty()) why += ": " + first_line;
-    w.warnings.push_back("plots skipped: " + why + " (script kept in " + out.final_path("plot.gp") + ")");
-    for (const auto& p : pngs) fs::remove(out.staging() / p, ec);
-    return;
-  }
-  for (const auto& p : pngs) {
-    if (complete_png(out.staging() / p)) {
-      w.files.push_back(out.final_path(p));
-    } else {
-      fs::remove(out.staging() / p, ec);
-      w.warnings.push_back("plot " + p + " was not produced in full (disk full?)");
-    }
-  }
-}
-
-std::string gp_header(const std::string& out, int width, int height) {
-  std::ostringstream s;
-  s << "set terminal pngcairo size " << width << "," << height << " font ',10'\n"
-    << "set output '" << out << "'\n";
-  return s.str();
-}
 
 std::string lines(const std::string& file, const std::string& x, const std::string& y, const std::string& title) {
   return "'" + file + "' using '" + x + "':'" + y + "' with lines lw 2 title '" + title + "'";
@@ -195,84 +120,10 @@ Written write_run(const Scene& scene, const RunRecord& r, OutputDir& out, bool p
     }
   }
 
-  json j;
-  j["lpshoot_version"] = "0.1.0";
-  j["command"] = r.command;
-  j["status"] = r.status;
-  j["converged"] = r.converged;
-  j["message"] = r.message;
-  if (!r.detail.empty()) j["detail"] = r.detail;
-  j["problem"] = r.problem;
-  j["scene_file"] = scene.file;
-  j["T"] = r.T;
-  j["N"] = r.N;
-  j["h"] = r.h;
-  if (!r.method.empty()) {
-    j["method"] = r.method;
-    j["segments"] = r.segments;
-    if (r.segments > 1) j["segment_starts"] = r.propagated_starts ? "forward sweep" : "guess";
-    j["backend"] = r.backend;
-    j["scheme"] = r.scheme;
-    if (!r.closure.empty()) j["closure"] = r.closure;
-  } else {
-    j["method"] = "discrete flow (Newton per step)";
-    j["backend"] = "lpshoot step Newton";
-  }
-  if (!r.constraints.empty()) j["constraints"] = r.constraints;
-  j["tolerance"] = r.tolerance;
-  if (r.error_estimate) {
-    const auto& e = *r.error_estimate;
-    if (!e.failure.empty())
-      j["error_estimate"] = {{"value", nullptr}, {"failure", e.failure}};
-    else
-      j["error_estimate"] = {{"value", e.value},
-                             {"observed_order", e.order_observed ? json(e.observed_order) : json(nullptr)},
-                             {"grids", {r.N, r.N / 2, r.N / 4}},
-                             {"differences", {e.d_fine, e.d_coarse}},
-                             {"columns", r.state_columns},
-                             {"extrapolation_order", e.extrapolation_order},
-                             {"wall_time_s", e.wall_time_s}};
-  }
-  if (!r.continuation_parameter.empty())
-    j["continuation"] = {{"parameter", "parameters." + r.continuation_parameter},
-                         {"path", r.continuation_path},
-                         {"solves", r.continuation_solves}};
-  j["cost"] = r.has_cost ? finite_or_null(r.cost) : json(nullptr);
-  j["action"] = finite_or_null(r.action);
-  j["iterations"] = r.iterations;
-  j["residual_norm"] = finite_or_null(r.residual_norm);
-  if (r.command == "solve") {
-    j["raw_residual_norm"] = finite_or_null(r.raw_residual_norm);
-    j["residual_history"] = json::array();
-    for (double x : r.residual_history) j["residual_history"].push_back(finite_or_null(x));
-    j["condition"] = finite_or_null(r.condition);
-    j["rank"] = r.rank >= 0 ? json(r.rank) : json(nullptr);
-    j["unknowns"] = r.unknowns;
-    if (!r.dependent_conditions.empty()) j["dependent_conditions"] = r.dependent_conditions;
-  } else {
-    j["condition"] = finite_or_null(r.condition);  // the largest per-step Newton condition number
-  }
-  if (r.has_momentum) {
-    j["momentum_drift"] = r.momentum_drift;
-    j["momentum_drift_relative"] = r.momentum_drift_relative;
-    j["momentum_initial"] = r.momentum_initial;
-    if (r.has_physical_momentum) {
-      j["physical_momentum_drift"] = r.physical_momentum_drift;
-      j["physical_momentum_initial"] = r.physical_momentum_initial;
-    }
-  } else {
-    j["momentum_drift"] = r.converged && r.problem == "electron" ? json(0.0) : json(nullptr);
-    j["momentum_note"] = r.problem == "electron" ? "the symmetry group is trivial: no momentum map to conserve"
-                                                 : "no trajectory";
-  }
-  j["wall_time_s"] = r.wall_time_s;
-  json fin = json::object();
-  for (const auto& [k, v] : r.final_state) fin[k] = finite_or_null(v);
-  j["final_state"] = fin;
+  json j = run_report(scene, r);
   w.files.insert(w.files.begin(), out.final_path("report.json"));
   j["files"] = w.files;
   j["warnings"] = w.warnings;
-  j["scene"] = json::parse(scene.effective_json);
   out.write("report.json", dump(j));
   out.commit();
   return w;
@@ -316,37 +167,10 @@ Written write_sweep(const Scene& scene, const SweepRecord& sw, OutputDir& out, b
     g << "\nset output\n";
     run_gnuplot(out, g.str(), {"sweep_error_time.png"}, w);
   }
-  json j;
-  j["lpshoot_version"] = "0.1.0";
-  j["command"] = "sweep";
-  j["status"] = sw.all_converged ? "converged" : "not_converged";
-  j["message"] = sw.message;
-  j["problem"] = sw.problem;
-  j["reference"] = sw.reference;
-  j["error_columns"] = sw.error_columns;
-  j["runs"] = json::array();
-  for (const auto& r : sw.runs) {
-    json x;
-    x["N"] = r.N;
-    x["h"] = r.h;
-    if (!r.method.empty())
-      x["scheme"] = r.scheme, x["method"] = r.method, x["backend"] = r.backend, x["segments"] = r.segments;
-    x["status"] = r.status;
-    x["converged"] = r.converged;
-    if (!r.converged) x["message"] = r.message;
-    x["error"] = finite_or_null(r.error);
-    x["order"] = finite_or_null(r.order);
-    x["cost"] = finite_or_null(r.cost);
-    x["cost_error"] = finite_or_null(r.cost_error);
-    x["wall_time_s"] = r.wall_time_s;
-    x["iterations"] = r.iterations;
-    x["momentum_drift"] = r.momentum_drift;
-    j["runs"].push_back(x);
-  }
+  json j = sweep_report(scene, sw);
   w.files.insert(w.files.begin(), out.final_path("sweep.json"));
   j["files"] = w.files;
   j["warnings"] = w.warnings;
-  j["scene"] = json::parse(scene.effective_json);
   out.write("sweep.json", dump(j));
   out.commit();
   return w;

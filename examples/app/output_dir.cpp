@@ -37,10 +37,10 @@ void remove_abandoned(const fs::path& parent, const std::string& prefix) {
 }  // namespace
 
 bool is_lpshoot_output(const std::string& name) {
-  static const std::array<const char*, 10> names = {"report.json",  "trajectory.csv", "trajectory_extrapolated.csv",
-                                                     "momentum.csv", "trajectory.png", "momentum.png",
-                                                     "plot.gp",      "sweep.json",     "sweep.csv",
-                                                     "sweep_error_time.png"};
+  static const std::array<const char*, 16> names = {
+      "report.json", "trajectory.csv", "trajectory_extrapolated.csv", "momentum.csv",    "trajectory.png", "momentum.png",
+      "plot.gp",     "sweep.json",     "sweep.csv",                   "sweep_error_time.png", "study.json", "study.jsonl",
+      "study.csv",   "study_spec.json", "study_pareto.png",           "study_cost.png"};
   if (std::find_if(names.begin(), names.end(), [&](const char* n) { return name == n; }) != names.end()) return true;
   // Temporary files of lpshoot versions that wrote file by file.
   return name == ".gnuplot.log" || (name.size() > 5 && name[0] == '.' && name.compare(name.size() - 4, 4, ".tmp") == 0);

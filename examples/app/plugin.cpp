@@ -75,14 +75,16 @@ LoadedPlugin load_problem_file(const std::string& source, const PluginOptions& o
   if (c.problems.empty())
     throw PluginError(source + ": the file registers no problem: give it a descriptor and a problem object, and "
                                "register it with LPSHOOT_REGISTER_PROBLEM(object) (README, \"A problem of your own\")");
+  // The same library loaded again (dlopen returns the same handle, so the same objects): its
+  // problems are registered already, and loading it is a no-op (a Python session re-running a cell).
   for (const Problem* p : c.problems) {
     const std::string& name = p->descriptor().name;
-    if (find_problem(name))
+    if (const Problem* known = find_problem(name); known && known != p)
       throw PluginError(source + ": problem \"" + name + "\" is already registered (a built-in problem or another "
                                  "--problem file has that name): rename it in the descriptor");
   }
   for (const Problem* p : c.problems) {
-    register_problem(*p);
+    if (!find_problem(p->descriptor().name)) register_problem(*p);
     loaded.problems.push_back(p->descriptor().name);
   }
   return loaded;

@@ -541,9 +541,13 @@ void read_continuation(const Reader& so, const json& scene, Scene& s) {
 }  // namespace
 
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
-  json j = parse_json_text(read_scene_file(path), path);
+  return load_scene_text(read_scene_file(path), path, overrides);
+}
+
+Scene load_scene_text(const std::string& text, const std::string& name, const std::vector<std::string>& overrides) {
+  json j = parse_json_text(text, name);
   for (const auto& o : overrides) apply_override(j, o);
-  return parse_scene(j, path);
+  return parse_scene(j, name);
 }
 
 Scene with_parameter(const Scene& s, const std::string& parameter, double value) {

@@ -94,6 +94,9 @@ bool set_scheme(Scene& s, const std::string& name);
 // Reads, applies the --set overrides ("key.path=value", value parsed as JSON when it is JSON,
 // else taken as a string; "null" removes the key), validates. Throws SceneError.
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides = {});
+// The same from the scene's JSON text; `name` stands for the file in messages and in the default
+// output directory (lpshoot-out/NAME).
+Scene load_scene_text(const std::string& text, const std::string& name, const std::vector<std::string>& overrides = {});
 
 // The scene with parameters.<parameter> set to value, validated again (throws SceneError).
 Scene with_parameter(const Scene& s, const std::string& parameter, double value);

@@ -20,6 +20,8 @@ double value_at(const Table& ref, int c, double t) {
   return (1 - w) * ref.columns[c][i] + w * ref.columns[c][i + 1];
 }
 
+}  // namespace
+
 double max_error(const Table& run, const Table& ref, const std::vector<std::string>& cols) {
   double e = 0;
   for (const auto& name : cols) {
@@ -30,8 +32,6 @@ double max_error(const Table& run, const Table& ref, const std::vector<std::stri
   }
   return e;
 }
-
-}  // namespace
 
 SweepRecord run_sweep(const Scene& scene, const std::string& command, const SweepOptions& opt, const Progress& progress) {
   SweepRecord rec;

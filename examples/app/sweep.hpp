@@ -34,6 +34,10 @@ struct SweepRecord {
   std::string message;  // the first failure, when any
 };
 
+// Max over run's nodes and the columns `cols` of |run - ref|, ref (first column t, uniform grid)
+// interpolated linearly where a node of run is not one of its nodes.
+double max_error(const Table& run, const Table& ref, const std::vector<std::string>& cols);
+
 // Throws SceneError for an N list or a scheme name that does not fit the scene. With several
 // schemes and no exact oracle, the reference is the finest grid of the highest-order scheme.
 SweepRecord run_sweep(const Scene& scene, const std::string& command, const SweepOptions& opt, const Progress& progress);

@@ -69,3 +69,13 @@ if(NOT SANITIZE)
   endif()
   message(STATUS "the installed lpshoot solves a problem of one's own: ok")
 endif()
+
+# (f) the installed Python module imports from the prefix (not the build tree) and solves a scene.
+if(PYTHON AND PYTHON_PACKAGE_DIR)
+  set(site "${prefix}/${PYTHON_PACKAGE_DIR}")
+  step("the installed Python module" ${CMAKE_COMMAND} -E env "PYTHONPATH=${site}" "${PYTHON}"
+       "${CMAKE_CURRENT_LIST_DIR}/check_python_module.py" "${PYTHON_SCENE}")
+  if(NOT step_output MATCHES "^${site}/lpshoot/__init__.py converged")
+    message(FATAL_ERROR "the Python module was not the installed one:\n${step_output}")
+  endif()
+endif()
