@@ -9,12 +9,12 @@ lpshoot="$build/examples/app/lpshoot"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 scenes=$(cd "$(dirname "$0")/../examples/scenes" && pwd)
-# 64 beanie solves (N = 200, four-segment multiple shooting).
+# 256 beanie solves (N = 200, four-segment multiple shooting).
 cat > "$work/study.json" <<JSON
 {"scene": "$scenes/beanie.json",
- "axes": {"parameters.I1": {"from": 0.5, "to": 2.0, "count": 8}, "parameters.I2": {"from": 0.25, "to": 1.0, "count": 8}}}
+ "axes": {"parameters.I1": {"from": 0.5, "to": 2.0, "count": 16}, "parameters.I2": {"from": 0.25, "to": 1.0, "count": 16}}}
 JSON
-points=64
+points=256
 mpirun=(mpirun --oversubscribe)
 [ "$(id -u)" = 0 ] && mpirun+=(--allow-run-as-root)
 

@@ -1,6 +1,6 @@
 // `lpshoot study` under mpirun (study_mpi.hpp). Messages: a rank sends rank 0 a row (JSON text),
-// "" when it is ready for its first point, or "!" when it stops (interrupted); rank 0 answers a
-// row or "" with a point index, or -1 for "stop".
+// "" when it is ready for its first points, or "!" when it stops (interrupted); rank 0 sends a
+// rank point indices (two ahead, then one per row returned), and -1 after its last one: "stop".
 #include "study_mpi.hpp"
 
 #include "interrupt.hpp"
@@ -52,26 +52,44 @@ MpiSession::~MpiSession() {
 }
 
 StudyExecutor mpi_master_executor(const MpiSession& world, bool* ran) {
-  const int workers = world.size() - 1;
-  return [workers, ran](const Study& study, const std::vector<size_t>& todo, const StudyRecorder& record,
-                        const Progress& checkpoint) {
+  const int size = world.size();
+  return [size, ran](const Study& study, const std::vector<size_t>& todo, const StudyRecorder& record,
+                     const Progress& checkpoint) {
     *ran = true;
+    // Every rank holds one point in hand beyond the one it solves, so it never waits for rank 0
+    // (which answers between its own points): two points on "ready", one more per row returned.
+    constexpr int ahead = 2;
     size_t next = 0;
-    int active = workers;  // ranks not yet told to stop (nor stopped by themselves)
-    // Answers one message: records its row, hands out the next point or "stop".
+    std::vector<int> pending(static_cast<size_t>(size), 0);  // points handed out, rows not yet back
+    std::vector<bool> stopped(static_cast<size_t>(size), false);
+    stopped[0] = true;
+    auto busy = [&] {
+      for (int w = 1; w < size; ++w)
+        if (!stopped[static_cast<size_t>(w)] || pending[static_cast<size_t>(w)] > 0) return true;
+      return false;
+    };
+    auto hand_out = [&](int to, int count) {
+      for (int k = 0; k < count && next < todo.size(); ++k, ++pending[static_cast<size_t>(to)])
+        send_index(static_cast<long long>(todo[next++]), to);
+      if (next >= todo.size() && !stopped[static_cast<size_t>(to)]) {  // after its last point, it stops
+        send_index(-1, to);
+        stopped[static_cast<size_t>(to)] = true;
+      }
+    };
+    // Answers one message: records its row, hands out what the rank needs next.
     auto serve = [&](bool block) {
       auto [from, text] = receive(block);
       if (from < 0) return false;
-      if (text == "!") {
-        --active;
-        return true;
-      }
-      if (!text.empty()) record(row_from_json(study, text));
-      if (next < todo.size()) {
-        send_index(static_cast<long long>(todo[next++]), from);
+      const size_t w = static_cast<size_t>(from);
+      if (text == "!") {  // interrupted: it stops, its points in hand are not done
+        stopped[w] = true;
+        pending[w] = 0;
+      } else if (text.empty()) {
+        hand_out(from, ahead);
       } else {
-        send_index(-1, from);
-        --active;
+        --pending[w];
+        record(row_from_json(study, text));
+        hand_out(from, 1);
       }
       return true;
     };
@@ -81,12 +99,14 @@ StudyExecutor mpi_master_executor(const MpiSession& world, bool* ran) {
         }
         if (next < todo.size()) record(run_study_point(study, todo[next++], checkpoint));
       }
+      for (int w = 1; w < size; ++w)  // ranks still waiting with nothing more to do
+        if (!stopped[static_cast<size_t>(w)] && pending[static_cast<size_t>(w)] > 0) hand_out(w, 0);
     } catch (...) {  // interrupted (or a row that does not parse): hand out nothing more, let every rank stop
       next = todo.size();
-      while (active > 0) serve(true);
+      while (busy()) serve(true);
       throw;
     }
-    while (active > 0) serve(true);
+    while (busy()) serve(true);
   };
 }
 
