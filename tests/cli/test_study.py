@@ -113,7 +113,7 @@ def test_two_shards_merged_give_the_same_rows(reference):
 def test_mpirun_gives_the_same_rows(reference, ranks):
     study, ref, work = reference
     out_dir = work / f"mpi{ranks}"
-    p = subprocess.run(MPIRUN + ["-np", str(ranks), CLI, "study", study, "--out", str(out_dir), "--no-plot", "--quiet"],
+    p = subprocess.run(MPIRUN + ["-np", str(ranks), CLI, "study", study, "--out", str(out_dir), "--no-plot"],
                        capture_output=True, text=True, timeout=600)
     assert p.returncode == 1, p.stdout + p.stderr  # mpirun passes on the exit code of the failed points
     assert rows(out_dir) == ref
