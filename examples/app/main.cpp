@@ -196,6 +196,11 @@ int run_command(int argc, char** argv) {
   study->add_option("args", study_args, "the study file (README, \"Studies\"), or merge and the shard directories")->required();
   study->add_option("--out", c.out, "the study's directory (default: lpshoot-out/STUDY; required for merge)");
   study->add_option("--threads", study_threads, "points solved at once (default: one per core)")->check(CLI::PositiveNumber);
+  double rank_timeout = 60;
+  study->add_option("--rank-timeout", rank_timeout,
+                    "under mpirun: seconds a rank may stay silent while solving before its points are marked lost "
+                    "(default 60; run mpirun --enable-recovery so that the others survive it)")
+      ->check(CLI::PositiveNumber);
   study->add_option("--shard", shard_text, "i/K: run only the points i, i+K, i+2K, ... (0 <= i < K; for job arrays)");
   study->add_flag("--no-plot", c.no_plot, "do not draw PNG plots");
   study->add_flag("--progress", c.progress, "show progress even when stderr is not a terminal");
@@ -244,6 +249,7 @@ int run_command(int argc, char** argv) {
     sc.out = c.out;
     sc.shard = shard_text;
     sc.threads = study_threads;
+    sc.rank_timeout_s = rank_timeout;
     sc.plot = !c.no_plot;
     sc.progress = c.progress;
     sc.quiet = c.quiet;

@@ -54,7 +54,7 @@ int run_study_command(const StudyCommand& c) {
     std::fprintf(stderr, "lpshoot: launched under mpirun, but this lpshoot was built without MPI: rank 0 runs the "
                          "study locally on its threads (install libopenmpi-dev and rebuild, or use --shard)\n");
   }
-  const MpiSession world;  // MPI_Init under mpirun (MPI builds)
+  MpiSession world;  // MPI_Init under mpirun (MPI builds)
   if (merge && world.rank() > 0) return 0;
   StudyOutcome o;
   std::string out = c.out;
@@ -90,7 +90,11 @@ int run_study_command(const StudyCommand& c) {
       if (world.size() > 1) {
         bool ran = false;
         try {
-          o = run_study(st, so, study_printer(c), mpi_master_executor(world, &ran));
+          const auto notify = [&world](const std::string& what) {
+            std::fprintf(stderr, "lpshoot: %s\n", what.c_str());
+            world.abort_at_exit();  // MPI_Finalize would wait for the lost rank forever
+          };
+          o = run_study(st, so, study_printer(c), mpi_master_executor(world, c.rank_timeout_s, notify, &ran));
         } catch (...) {
           if (!ran) mpi_release_workers(world);
           throw;
@@ -112,12 +116,12 @@ int run_study_command(const StudyCommand& c) {
     return 128 + e.signal;
   }
   print_files(o.written);
-  if (o.failures > 0) {
-    std::fprintf(stderr, "lpshoot: %zu of %zu points did not converge or were invalid (their rows say why)\n", o.failures,
+  if (o.failures > 0)
+    std::fprintf(stderr, "lpshoot: %zu of %zu points failed: not converged, invalid or lost (their rows say why)\n", o.failures,
                  o.points);
-    return 1;
-  }
-  return 0;
+  const int code = o.failures > 0 ? 1 : 0;
+  world.set_exit_code(code);
+  return code;
 }
 
 }  // namespace lpshoot::app

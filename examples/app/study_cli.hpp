@@ -11,6 +11,7 @@ struct StudyCommand {
   std::vector<std::string> args;  // the study file, or "merge" and the shard directories
   std::string out, shard;         // shard: "i/K" or empty
   int threads = 0;
+  double rank_timeout_s = 60;  // under mpirun: a rank silent this long while holding points is lost
   bool plot = true, progress = false, quiet = false;
 };
 

@@ -11,7 +11,7 @@ bool launched_by_mpirun() { return std::getenv("OMPI_COMM_WORLD_SIZE") || std::g
 bool mpi_built() { return false; }
 MpiSession::MpiSession() = default;
 MpiSession::~MpiSession() = default;
-StudyExecutor mpi_master_executor(const MpiSession&, bool*) { throw std::logic_error("lpshoot was built without MPI"); }
+StudyExecutor mpi_master_executor(const MpiSession&, double, const std::function<void(const std::string&)>&, bool*) { throw std::logic_error("lpshoot was built without MPI"); }
 void mpi_release_workers(const MpiSession&) {}
 void mpi_worker(const Study&) { throw std::logic_error("lpshoot was built without MPI"); }
 

@@ -39,8 +39,8 @@ Study study_from_spec(const json& j, const std::string& file) {
   return s;
 }
 
-// The rows in DIR/study.jsonl by point index. A line cut short by a kill is dropped (its point
-// runs again); a row of another study is an error.
+// The rows in DIR/study.jsonl by point index (a point's last row wins). A line cut short by a kill
+// and a rank_lost row are dropped (their points run again); a row of another study is an error.
 std::map<size_t, StudyRow> read_rows(const Study& study, const fs::path& dir) {
   std::map<size_t, StudyRow> rows;
   std::ifstream in(dir / "study.jsonl");
@@ -49,7 +49,8 @@ std::map<size_t, StudyRow> read_rows(const Study& study, const fs::path& dir) {
     if (line.empty() || line.back() != '}') continue;  // a partial last line
     try {
       StudyRow r = row_from_json(study, line);
-      rows.emplace(r.index, std::move(r));
+      if (r.status == "rank_lost") rows.erase(r.index);  // not solved: a rerun solves it
+      else rows.insert_or_assign(r.index, std::move(r));  // the last row of a point wins
     } catch (const SceneError& e) {
       throw OutputError((dir / "study.jsonl").string() + ":" + std::to_string(n) + ": " + e.what() +
                         " (the directory holds another study's rows: choose another --out)");
@@ -286,8 +287,10 @@ StudyOutcome run_study(const Study& study, const StudyOptions& o, const std::fun
     ++p.done;
     p.failures += row.status != "converged";
     p.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    p.remaining_s = p.elapsed_s / static_cast<double>(p.done) * static_cast<double>(p.total - p.done);
-    done.emplace(row.index, std::move(row));
+    p.remaining_s = p.done < p.total ? p.elapsed_s / static_cast<double>(p.done) * static_cast<double>(p.total - p.done) : 0;
+    // A point's later row wins (a rank declared lost that answers after all replaces rank_lost).
+    if (const auto it = done.find(row.index); it == done.end() || it->second.status == "rank_lost")
+      done.insert_or_assign(row.index, std::move(row));
     if (progress) progress(p);
   };
   const Progress checkpoint = [](const std::string&) { throw_if_interrupted(); };

@@ -1,7 +1,8 @@
 """`lpshoot study` end to end: the same rows locally with 1 and 2 threads, under mpirun with 1, 2
 and 4 ranks (MPI builds), and as two shards merged; invalid and non-converging points are rows
-with their status while the others match single solves; an interrupted study completes on a
-rerun without redoing its finished points; bad study files fail naming the key.
+with their status while the others match single solves; a rank killed mid-study is reported, its
+points marked rank_lost, the study finishes and a rerun solves them; an interrupted study
+completes on a rerun without redoing its finished points; bad study files fail naming the key.
 Run by ctest (tests/cli/CMakeLists.txt) with LPSHOOT_CLI, LPSHOOT_SCENES and LPSHOOT_WITH_MPI."""
 
 import json
@@ -58,7 +59,7 @@ def reference(tmp_path_factory):
     study = write_study(work / "grid.json", STUDY)
     code, out, err = lpshoot("study", study, "--threads", "1", "--out", str(work / "one"), "--no-plot")
     assert code == 1, out + err  # some points do not converge: exit 1, and it says so
-    assert "did not converge or were invalid" in err
+    assert "points failed" in err
     return study, rows(work / "one"), work
 
 
@@ -119,6 +120,57 @@ def test_mpirun_gives_the_same_rows(reference, ranks):
     assert rows(out_dir) == ref
     if ranks > 1:
         assert f"on {ranks} MPI ranks" in p.stderr
+
+
+def rank_pid(study, rank):
+    """The pid of the lpshoot process of MPI rank `rank` running `study`, or None."""
+    for proc in Path("/proc").iterdir():
+        try:
+            if proc.name.isdigit() and study.encode() in (proc / "cmdline").read_bytes() and \
+                    f"OMPI_COMM_WORLD_RANK={rank}".encode() in (proc / "environ").read_bytes().split(b"\0"):
+                return int(proc.name)
+        except OSError:
+            pass
+    return None
+
+
+@pytest.mark.skipif(not WITH_MPI, reason="lpshoot was built without MPI")
+def test_a_rank_that_dies_is_reported_and_the_study_finishes(tmp_path):
+    # 16 points of about a quarter second on 3 ranks; rank 2 is killed once the first row is in.
+    study = write_study(tmp_path / "slow.json", {
+        "scene": str(SCENES / "beanie.json"),
+        "axes": {"parameters.I2": {"from": 0.4, "to": 0.6, "count": 16}, "horizon.N": [4000]},
+    })
+    out_dir = tmp_path / "out"
+    proc = subprocess.Popen(MPIRUN + ["--enable-recovery", "-np", "3", CLI, "study", study, "--out", str(out_dir),
+                                      "--no-plot", "--rank-timeout", "3"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    jsonl = out_dir / "study.jsonl"
+    deadline = time.time() + 120
+    while time.time() < deadline and (not jsonl.exists() or not jsonl.read_text().strip()):
+        time.sleep(0.05)
+    try:
+        pid = rank_pid(study, 2)
+        assert pid, "rank 2 not found"
+        os.kill(pid, signal.SIGKILL)
+        out, err = proc.communicate(timeout=300)
+    finally:
+        if proc.poll() is None:  # a hang must not outlive the test
+            proc.kill()
+    # Rank 0 ends the job with MPI_Abort(1) (MPI_Finalize would wait for the lost rank); what
+    # mpirun --enable-recovery then returns is its own affair (OpenMPI 4.1: 0). The study says it.
+    assert "rank 2 stopped answering" in err, out + err
+    assert json.loads((out_dir / "study.json").read_text())["status"] == "completed_with_failures"
+    r = rows(out_dir)
+    assert sorted(r) == list(range(16))
+    lost = [x for x in r.values() if x["status"] == "rank_lost"]
+    assert lost and all("MPI rank 2" in x["message"] for x in lost)
+    assert all(x["status"] == "converged" for x in r.values() if x["status"] != "rank_lost")
+    # A rerun solves the lost points only.
+    code, out, err = lpshoot("study", study, "--out", str(out_dir), "--no-plot", "--quiet")
+    assert code == 0, err
+    assert f"{len(lost)} run now, {16 - len(lost)} done before" in out
+    assert all(x["status"] == "converged" for x in rows(out_dir).values())
 
 
 def test_an_interrupted_study_completes_on_a_rerun(tmp_path):
