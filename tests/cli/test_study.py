@@ -18,7 +18,8 @@ import pytest
 CLI = os.environ.get("LPSHOOT_CLI", "lpshoot")
 SCENES = Path(os.environ.get("LPSHOOT_SCENES", Path(__file__).resolve().parents[2] / "examples" / "scenes"))
 WITH_MPI = os.environ.get("LPSHOOT_WITH_MPI", "OFF") == "ON"
-MPIRUN = ["mpirun", "--oversubscribe"] + (["--allow-run-as-root"] if os.geteuid() == 0 else [])
+# vader without single-copy (CMA): containers often forbid the ptrace it needs.
+MPIRUN = ["mpirun", "--oversubscribe", "--mca", "btl_vader_single_copy_mechanism", "none"] + (["--allow-run-as-root"] if os.geteuid() == 0 else [])
 
 # 5 x 2 x 2 = 20 points of the beanie: I1 = -1 is invalid (4 rows), max_iterations = 1 stops
 # Newton before convergence (8 rows, the beanie needs 3), the other 8 converge.
