@@ -1,10 +1,14 @@
 // Problems of one's own from one C++ file (issue 10): the application builds a plugin from a
 // source file, runs solve, sweep, check and problems on it, takes it from its cache the second
-// time, and fails cleanly, naming the file, on bad plugins. The oscillator's optimum is known in
+// time, rebuilds a cached library that carries another build stamp, and fails cleanly, naming
+// the file, on bad plugins. The oscillator's optimum is known in
 // closed form, so the trajectory and the cost are checked against a reference computed here.
 #include "cli_helpers.hpp"
 
 #include <Eigen/Dense>
+
+#include <iterator>
+#include <regex>
 
 using namespace lpshoot_cli_test;
 
@@ -99,6 +103,32 @@ TEST(Plugins, OscillatorFromItsOwnFileMatchesTheExactOptimum) {
   ASSERT_EQ(second.code, 0) << second.err;
   EXPECT_EQ(second.err.find("building"), std::string::npos) << second.err;
   EXPECT_EQ(json::parse(std::ifstream(work / "again" / "report.json"))["cost"], report["cost"]);
+
+  // A library built against another lpshoot is rebuilt, not loaded: give the cached one another
+  // build stamp (every "VERSION+<40 hex>" in it, same length), then run again.
+  {
+    fs::path library;
+    for (const auto& entry : fs::recursive_directory_iterator(work / "cache"))
+      if (entry.path().filename() == "problem.so") library = entry.path();
+    ASSERT_FALSE(library.empty()) << "no cached plugin library";
+    std::string bytes;
+    {
+      std::ifstream in(library, std::ios::binary);
+      bytes.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    const std::regex stamp("0\\.1\\.0\\+[0-9a-f]{40}");
+    size_t patched = 0;
+    for (auto it = std::sregex_iterator(bytes.begin(), bytes.end(), stamp); it != std::sregex_iterator(); ++it, ++patched)
+      bytes.replace(static_cast<size_t>(it->position()) + 6, 40, std::string(40, '0'));
+    ASSERT_GT(patched, 0u) << "no build stamp found in " << library;
+    std::ofstream(library, std::ios::binary | std::ios::trunc) << bytes;
+    const Outcome other = run_cli("solve" + problem + " '" + oscillator_scene + "' --no-plot --out '" +
+                                      (work / "rebuilt").string() + "'",
+                                  work);
+    ASSERT_EQ(other.code, 0) << other.err;
+    EXPECT_NE(other.err.find("building"), std::string::npos) << "a foreign build stamp must trigger a rebuild: " << other.err;
+    EXPECT_EQ(json::parse(std::ifstream(work / "rebuilt" / "report.json"))["cost"], report["cost"]);
+  }
 
   // Sweep: the schemes' orders 4 and 6 on the plugin's problem.
   const Outcome sw = run_cli("sweep" + problem + " '" + oscillator_scene + "' --N 10,20,40,80 --scheme galerkin4,galerkin6 --no-plot --out '" +

@@ -1,0 +1,72 @@
+"""The cart-pendulum (examples/app/problem_cart_pendulum.cpp) against what it models. The force
+that moves the solved cart, u = (M+m) v' + m l (cos psi psi_dot' - sin psi psi_dot^2) from the
+columns, fed to the full two-degree-of-freedom equations of cart and pendulum (integrated here by
+RK4) reproduces the solved pendulum angle: the unactuated pendulum obeys its own equation (a
+wrong sign or term in the model's constraint is off by O(0.1)). The scheme's momentum map is
+conserved; the error falls at the schemes' orders."""
+
+import math
+
+import numpy as np
+
+import lpshoot
+from conftest import scene_path
+
+
+def dynamics(state, u, M, m, l, g):
+    """(x, psi, v, psi_dot)' under cart force u: the Euler-Lagrange equations of
+    L = 1/2 (M+m) v^2 + m l cos(psi) v psi' + 1/2 m l^2 psi'^2 + m g l cos(psi)."""
+    x, psi, v, w = state
+    c, s = math.cos(psi), math.sin(psi)
+    a, alpha = np.linalg.solve(np.array([[M + m, m * l * c], [c, l]]), np.array([u + m * l * s * w * w, -g * s]))
+    return np.array([v, w, a, alpha])
+
+
+def local_cubic(t_nodes, values, t):
+    """The cubic through the four nodes around t (uniform grid)."""
+    h = t_nodes[1] - t_nodes[0]
+    i = min(max(int(t / h) - 1, 0), len(t_nodes) - 4)
+    ts, ys = t_nodes[i:i + 4], values[i:i + 4]
+    return sum(ys[j] * np.prod([(t - ts[k]) / (ts[j] - ts[k]) for k in range(4) if k != j]) for j in range(4))
+
+
+def test_the_pendulum_obeys_its_equation_under_the_cart_force():
+    scene = scene_path("cart_pendulum")
+    p = lpshoot.check(scene)["scene"]["parameters"]
+    M, m, l, g = p["M"], p["m"], p["l"], p["g"]
+    r = lpshoot.solve(scene, {"horizon.N": 600})
+    assert r.converged, r.message
+    tr = r.trajectory
+    t = tr["t"]
+    h = t[1] - t[0]
+    assert abs(tr["x"][-1] - 1.0) < 1e-10 and abs(tr["psi"][-1]) < 1e-10 and abs(tr["v"][-1]) < 1e-10
+    # The cart's force from the solved motion (second-order differences of the node velocities).
+    a, alpha = np.gradient(tr["v"], h, edge_order=2), np.gradient(tr["psi_dot"], h, edge_order=2)
+    psi, w = tr["psi"], tr["psi_dot"]
+    u = (M + m) * a + m * l * (np.cos(psi) * alpha - np.sin(psi) * w * w)
+    state = np.array([tr["x"][0], psi[0], tr["v"][0], w[0]])
+    steps = 4
+    dt = h / steps
+    worst = 0.0
+    f = lambda tt, y: dynamics(y, local_cubic(t, u, tt), M, m, l, g)
+    for n in range(len(t) - 1):
+        for k in range(steps):
+            s = t[n] + k * dt
+            k1 = f(s, state)
+            k2 = f(s + dt / 2, state + dt / 2 * k1)
+            k3 = f(s + dt / 2, state + dt / 2 * k2)
+            k4 = f(s + dt, state + dt * k3)
+            state = state + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        worst = max(worst, abs(state[1] - psi[n + 1]), abs(state[0] - tr["x"][n + 1]))
+    assert max(abs(psi)) > 0.05  # the pendulum does swing: the check is not vacuous
+    assert worst < 1e-3 * max(abs(psi)), worst
+    # J is conserved by the scheme up to the Newton residual (tolerance 1e-10 per condition, N = 600).
+    assert r.report["momentum_drift"] < 1e-8
+
+
+def test_orders_of_the_schemes():
+    sw = lpshoot.sweep(scene_path("cart_pendulum"), [15, 30, 60, 120], schemes=["galerkin4", "galerkin6"])
+    assert sw.converged, sw.message
+    order = {(row["scheme"], row["N"]): row["order"] for row in sw.runs}
+    assert 3.6 < order["galerkin4", 60] < 4.4, sw.runs
+    assert 5.4 < order["galerkin6", 30] < 6.6, sw.runs
