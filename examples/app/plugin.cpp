@@ -52,7 +52,8 @@ LoadedPlugin load_problem_file(const std::string& source, const PluginOptions& o
   if (!lib.contents) {
     // Not built yet, or built against other headers (another lpshoot build in the same cache
     // entry): build it afresh.
-    if (lib.handle) {  // its contents were never taken, so nothing refers to its code
+    const bool stale = lib.handle != nullptr;
+    if (stale) {  // its contents were never taken, so nothing refers to its code
       dlclose(lib.handle);
       fs::remove_all(fs::path(cache) / key, ec);
     }
@@ -61,7 +62,11 @@ LoadedPlugin load_problem_file(const std::string& source, const PluginOptions& o
     loaded.library = pd::build(source, cache, key);
     loaded.built = true;
     loaded.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    lib = open_library(source, loaded.library);
+    // dlclose does not unmap a library with STB_GNU_UNIQUE symbols (C++ inline statics), and
+    // dlopen matches loaded libraries by the path string first: the stale image would come back.
+    // Another spelling of the path makes dlopen compare the file itself, which is new.
+    const fs::path fresh = fs::path(loaded.library).parent_path() / "." / fs::path(loaded.library).filename();
+    lib = open_library(source, stale ? fresh.string() : loaded.library);
     if (!lib.contents)
       throw PluginError(source + ": the plugin was built against lpshoot " + lib.stamp + ", not this lpshoot (" +
                         LPSHOOT_BUILD_STAMP + "): check that lpshoot's package directory is this build's");
