@@ -23,17 +23,6 @@ namespace fs = std::filesystem;
 
 constexpr size_t max_points = 10'000'000;
 
-// The shortest text that reads back as x; integral values as integers (so "horizon.N" takes them).
-std::string number_text(double x) {
-  if (std::floor(x) == x && std::abs(x) < 9e15) return std::to_string(static_cast<long long>(x));
-  char buf[32];
-  for (int precision = 15; precision <= 17; ++precision) {
-    std::snprintf(buf, sizeof buf, "%.*g", precision, x);
-    if (std::strtod(buf, nullptr) == x) break;
-  }
-  return buf;
-}
-
 std::string read_text(const std::string& path, const std::string& what) {
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) throw SceneError(path + ": cannot read the " + what + ": no such file");
@@ -127,6 +116,16 @@ json value_or_null(double x) { return std::isfinite(x) ? json(x) : json(nullptr)
 double number_or_nan(const json& v) { return v.is_number() ? v.get<double>() : nan(); }
 
 }  // namespace
+
+std::string number_text(double x) {
+  if (std::floor(x) == x && std::abs(x) < 9e15) return std::to_string(static_cast<long long>(x));
+  char buf[32];
+  for (int precision = 15; precision <= 17; ++precision) {
+    std::snprintf(buf, sizeof buf, "%.*g", precision, x);
+    if (std::strtod(buf, nullptr) == x) break;
+  }
+  return buf;
+}
 
 size_t Study::points() const {
   size_t n = 1;

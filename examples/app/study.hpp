@@ -32,6 +32,9 @@ struct Study {
   std::vector<std::string> point(size_t i) const;
 };
 
+// The shortest text that reads back as x; integral values as integers (so "horizon.N" takes them).
+std::string number_text(double x);
+
 // Reads and checks a study file (not its points' scenes). Throws SceneError naming the key.
 Study load_study(const std::string& path);
 

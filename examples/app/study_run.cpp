@@ -90,15 +90,7 @@ std::string csv_field(const std::string& s) {
   return q + "\"";
 }
 
-std::string csv_number(double x) {  // the shortest text that reads back as x; empty for none
-  if (!std::isfinite(x)) return "";
-  char buf[32];
-  for (int precision = 15; precision <= 17; ++precision) {
-    std::snprintf(buf, sizeof buf, "%.*g", precision, x);
-    if (std::strtod(buf, nullptr) == x) break;
-  }
-  return buf;
-}
+std::string csv_number(double x) { return std::isfinite(x) ? number_text(x) : std::string(); }  // empty: none
 
 std::string study_csv(const Study& st, const std::vector<StudyRow>& rows) {
   std::string s = "index";
