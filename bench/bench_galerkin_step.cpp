@@ -88,6 +88,30 @@ static void BM_ElectronGalerkinStep(benchmark::State& st) {
 BENCHMARK_TEMPLATE(BM_ElectronGalerkinStep, 3)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 BENCHMARK_TEMPLATE(BM_ElectronGalerkinStep, 4)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
+// The step's equations with the state's columns (what each sensitivity costs), electron: /0
+// nested duals through the jet and ℓ (evaluate_galerkin_step_nested), /1 the chain rule through
+// the jet (galerkin_flat.hpp, the engine's choice without a group; no carry: both intervals).
+template <int S>
+static void BM_ElectronStepDerivatives(benchmark::State& st) {
+  using Sch = ElectronGalerkin<S>;
+  constexpr int nz = Sch::unknowns, ns = Sch::state;
+  const ElectronModel m = model_of(Electron{});
+  const auto state = electron_start<S>(m);
+  Interval<Sch, double> z;
+  solve_galerkin_step<Sch>(m, kH, state, 1, NewtonOptions{}, z);
+  Vec<double, nz> F;
+  Eigen::Matrix<double, nz, nz + ns> J;
+  for (auto _ : st) {
+    if (st.range(0) == 0)
+      evaluate_galerkin_step_nested<Sch, nz + ns>(m, kH, state, z, true, nullptr, F, J);
+    else
+      evaluate_galerkin_step_flat<Sch, nz + ns>(m, kH, state, z, true, nullptr, F, J);
+    benchmark::DoNotOptimize(J.data());
+  }
+}
+BENCHMARK_TEMPLATE(BM_ElectronStepDerivatives, 3)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK_TEMPLATE(BM_ElectronStepDerivatives, 4)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
 template <int S>
 static void BM_BeanieGalerkinFlow(benchmark::State& st) {
   flow<BeanieGalerkin<S>>(st, beanie(), beanie_start<S>(beanie()), st.range(0) != 0);

@@ -89,15 +89,16 @@ class GalerkinFlow {
     // Newton iterates with it first (newton_solve, `previous`).
     Eigen::Matrix<double, nz, nz> step_matrix;
     bool have_step_matrix = false;
+    StepCarry<Sch> carry;  // interval derivatives shared by consecutive steps
     for (int k = 1; k <= steps; ++k) {
       Interval<Sch, double> z;
       if (!rep.add(solve_galerkin_step<Sch>(model_, h_, s, first_node + k, options_, z,
-                                            have_step_matrix ? &step_matrix : nullptr)))
+                                            have_step_matrix ? &step_matrix : nullptr, &carry)))
         return out;
       if (seed) {
         double condition = 0;
         const Eigen::Matrix<double, nz, ns> dz =
-            galerkin_step_sensitivity<Sch>(model_, h_, s, z, &step_matrix, &condition);
+            galerkin_step_sensitivity<Sch>(model_, h_, s, z, &step_matrix, &condition, &carry);
         rep.max_condition = std::max(rep.max_condition, condition);
         if (!(condition <= options_.max_condition)) {  // regular at the predictor, not at the solution
           --rep.steps;

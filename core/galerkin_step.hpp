@@ -9,6 +9,7 @@
 #pragma once
 
 #include "galerkin.hpp"
+#include "galerkin_flat.hpp"
 #include "newton.hpp"
 
 namespace lpshoot {
@@ -109,9 +110,10 @@ Interval<Sch, T> seeded_state(const Interval<Sch, double>& state, double h, int 
 //   the base columns are mapped to the state's by that linear map.
 // - Interval n-1 (the state) enters E_n only: differentiated in its own smooth coordinates.
 template <class Sch, int NO>
-void evaluate_galerkin_step(const typename Sch::Model& model, double h, const Interval<Sch, double>& state,
-                            const Interval<Sch, double>& z, bool with_state, const Vec<double, Sch::variation>* fixed,
-                            Vec<double, Sch::unknowns>& F, Eigen::Matrix<double, Sch::unknowns, NO>& J) {
+void evaluate_galerkin_step_nested(const typename Sch::Model& model, double h, const Interval<Sch, double>& state,
+                                   const Interval<Sch, double>& z, bool with_state,
+                                   const Vec<double, Sch::variation>* fixed, Vec<double, Sch::unknowns>& F,
+                                   Eigen::Matrix<double, Sch::unknowns, NO>& J) {
   using G = typename Sch::Group;
   constexpr int r = Sch::r, d = Sch::d, nv = Sch::variation, na = Sch::aux, nz = Sch::unknowns, ns = Sch::state;
   constexpr int node = Sch::node, nm = multiplier_count<Sch>, nzs = nz - nm, nss = ns - nm, nb = na - nm;
@@ -195,6 +197,22 @@ void evaluate_galerkin_step(const typename Sch::Model& model, double h, const In
   }
 }
 
+// Without a group the jet is linear in the intervals' coordinates, and with the state's columns
+// the chain rule through it is cheaper (galerkin_flat.hpp); otherwise nested duals, which for the
+// step matrix alone are narrower (unknowns x node directions) than the jet's Hessian.
+template <class Sch, int NO>
+void evaluate_galerkin_step(const typename Sch::Model& model, double h, const Interval<Sch, double>& state,
+                            const Interval<Sch, double>& z, bool with_state, const Vec<double, Sch::variation>* fixed,
+                            Vec<double, Sch::unknowns>& F, Eigen::Matrix<double, Sch::unknowns, NO>& J,
+                            StepCarry<Sch>* carry = nullptr) {
+  if constexpr (Sch::d == 0 && NO != Sch::unknowns) {
+    evaluate_galerkin_step_flat<Sch, NO>(model, h, state, z, with_state, fixed, F, J, carry);
+  } else {
+    (void)carry;
+    evaluate_galerkin_step_nested<Sch, NO>(model, h, state, z, with_state, fixed, F, J);
+  }
+}
+
 template <class Sch>
 Vec<double, Sch::unknowns> galerkin_step_residual(const typename Sch::Model& model, double h,
                                                   const Interval<Sch, double>& state, const Interval<Sch, double>& z,
@@ -226,15 +244,26 @@ void apply_galerkin_correction(Interval<Sch, double>& z, const Vec<double, Sch::
 // Solves step n (interval n from interval n-1 = `state`) by Newton from the predictor "interval
 // n-1's unknowns"; on return z is interval n (its base node included).
 // `previous`: the step matrix of step n-1 at its solution, for chord iterations (newton_solve).
+// `carry`: the state's derivatives, when the flow has them (its part of E_n is read off them).
 template <class Sch>
 StepReport solve_galerkin_step(const typename Sch::Model& model, double h, const Interval<Sch, double>& state, int n,
                                const NewtonOptions& opt, Interval<Sch, double>& z,
-                               const Eigen::Matrix<double, Sch::unknowns, Sch::unknowns>* previous = nullptr) {
+                               const Eigen::Matrix<double, Sch::unknowns, Sch::unknowns>* previous = nullptr,
+                               const StepCarry<Sch>* carry = nullptr) {
   constexpr int r = Sch::r, d = Sch::d, nz = Sch::unknowns, nv = Sch::variation;
   z = state;
   const Interval<Sch, double> base = next_interval_base(state, h);
   z.x = base.x, z.v = base.v, z.Om = base.Om;
-  const Vec<double, nv> fixed = node_residual<Sch, double>(model, &state, nullptr, h);
+  Vec<double, nv> fixed;
+  if constexpr (Sch::d == 0) {
+    if (carry && carry->valid)
+      fixed = (FlatStepMaps<Sch>(h).left.template topRows<nv>() * carry->interval.gradient) / h;
+    else
+      fixed = node_residual<Sch, double>(model, &state, nullptr, h);
+  } else {
+    (void)carry;
+    fixed = node_residual<Sch, double>(model, &state, nullptr, h);
+  }
   if (!all_finite(fixed.data(), nv)) {
     StepReport rep;
     rep.step = n;
@@ -262,15 +291,17 @@ StepReport solve_galerkin_step(const typename Sch::Model& model, double h, const
 
 // dz/d(state) at a solved step (nz x ns), by the implicit function theorem. Optionally the step
 // matrix ∂F/∂z there (for the next step's chord iterations) and its 1-norm condition number (the
-// regularity check at the solution).
+// regularity check at the solution). `carry`: a flow's derivatives of the state from the step
+// before, updated to this step's (galerkin_flat.hpp).
 template <class Sch>
 Eigen::Matrix<double, Sch::unknowns, Sch::state> galerkin_step_sensitivity(
     const typename Sch::Model& model, double h, const Interval<Sch, double>& state, const Interval<Sch, double>& z,
-    Eigen::Matrix<double, Sch::unknowns, Sch::unknowns>* step_matrix = nullptr, double* condition = nullptr) {
+    Eigen::Matrix<double, Sch::unknowns, Sch::unknowns>* step_matrix = nullptr, double* condition = nullptr,
+    StepCarry<Sch>* carry = nullptr) {
   constexpr int nz = Sch::unknowns, ns = Sch::state;
   Vec<double, nz> F;
   Eigen::Matrix<double, nz, nz + ns> J;
-  evaluate_galerkin_step<Sch, nz + ns>(model, h, state, z, true, nullptr, F, J);
+  evaluate_galerkin_step<Sch, nz + ns>(model, h, state, z, true, nullptr, F, J, carry);
   const Eigen::Matrix<double, nz, nz> Jz = J.template leftCols<nz>();
   const Eigen::Matrix<double, nz, ns> Js = J.template rightCols<ns>();
   const Eigen::PartialPivLU<Eigen::Matrix<double, nz, nz>> lu(Jz);

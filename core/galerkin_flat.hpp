@@ -1,0 +1,186 @@
+// Galerkin step derivatives for problems without a group (d = 0) by the chain rule through the
+// jet (issue 9). Without a group the jet at Gauss point i is linear in the interval's smooth
+// coordinates y = (x, v, X2, V1, a_1 .. a_{S-3}) (galerkin.hpp, jet_at):
+//   q_i = M_i y,  M_i = K_i ⊗ I_r,  K_i = [1  hτ  h²H01  h²H11  h²β_j ;
+//                                          0  1   h H01'  h H11'  h β_j' ;
+//                                          0  0    H01''   H11''   β_j'']   (at τ_i),
+// so with φ_i = ℓ + λ_i · χ (one interval's multipliers λ_i at point i)
+//   ∇_y L~ = h Σ b_i M_iᵀ ∇φ_i(q_i),  ∇²_y L~ = h Σ b_i M_iᵀ ∇²φ_i(q_i) M_i,
+//   ∂C_{i,c}/∂y = h b_i M_iᵀ ∇χ_c(q_i),
+// where ∇φ_i and ∇²φ_i are taken in the jet's 3r directions only (nested duals of width 3r),
+// instead of carrying every step direction through the jet and ℓ. The step's equations and
+// their derivatives are then linear maps of each interval's gradient and Hessian in (y, λ):
+//   F = (A_l ∇L~_{n-1} + A_r ∇L~_n) / h,  ∂F/∂z = A_r ∇²L~_n S_z / h,
+//   ∂F/∂state = (A_l ∇²L~_{n-1} + A_r ∇²L~_n S_b) / h,
+// with A_l, A_r the node perturbations of perturb_node (and interval n's own rows), S_z the
+// placement of the unknowns in interval n and S_b its base node as a function of the state.
+// Same equations as the nested-dual evaluation (evaluate_galerkin_step_nested), to roundoff.
+#pragma once
+
+#include "galerkin.hpp"
+
+#include <type_traits>
+
+namespace lpshoot {
+
+// One interval's L~ = L0 + λ · C as a function of (y, λ): gradient and Hessian (the (λ, λ)
+// block is zero).
+template <class Sch>
+struct FlatIntervalDerivatives {
+  static constexpr int r = Sch::r, nm = multiplier_count<Sch>;
+  static constexpr int ny = Sch::state - nm;  // (x, v, X2, V1, bubbles): the state's own layout
+  static constexpr int ne = ny + nm;
+  Vec<double, ne> gradient;                  // (∂L~/∂y, C)
+  Eigen::Matrix<double, ne, ne> hessian;     // [[∇²_y L~, ∂C/∂y], [∂C/∂yᵀ, 0]]
+};
+
+template <class Sch>
+FlatIntervalDerivatives<Sch> flat_interval_derivatives(const typename Sch::Model& model,
+                                                       const Interval<Sch, double>& iv, double h) {
+  static_assert(Sch::d == 0, "the jet is linear in the interval's coordinates only without a group");
+  using C = typename Sch::Model;
+  using D = FlatIntervalDerivatives<Sch>;
+  constexpr int r = Sch::r, m = Sch::m, nb = Sch::bubbles, ny = D::ny, ne = D::ne, nm = D::nm, nq = 3 * r;
+  constexpr int cols = 4 + nb;  // x, v, X2, V1, bubbles (scalar columns of K)
+  using T1 = Dual<double, nq>;
+  using T2 = Dual<T1, nq>;
+  const auto& tab = GalerkinTable<Sch::degree, Sch::gauss>::get();
+
+  Vec<double, ny> y;
+  y << iv.x, iv.v, iv.X2, iv.V1, iv.w.template head<ny - 4 * r>();
+  D out;
+  out.gradient.setZero();
+  out.hessian.setZero();
+  for (int i = 0; i < Sch::gauss; ++i) {
+    const auto& B = tab.basis[i];
+    const double tau = tab.c[i], w = h * tab.b[i];
+    Eigen::Matrix<double, 3, cols> K = Eigen::Matrix<double, 3, cols>::Zero();
+    K(0, 0) = 1, K(0, 1) = h * tau, K(1, 1) = 1;
+    for (int f = 0; f < 2 + nb; ++f)  // X2 (H01), V1 (H11), bubbles: basis functions 2, 3, 4 ..
+      for (int k = 0; k < 3; ++k) K(k, 2 + f) = B[2 + f][k] * std::pow(h, 2 - k);
+    // q = (K ⊗ I_r) y, block by block (K is sparse: its zeros are skipped below as well).
+    Vec<double, nq> qv = Vec<double, nq>::Zero();
+    for (int k = 0; k < 3; ++k)
+      for (int j = 0; j < cols; ++j)
+        if (K(k, j) != 0.0) qv.template segment<r>(k * r) += K(k, j) * y.template segment<r>(j * r);
+
+    // φ = ℓ + λ_i · χ on the jet, every jet coordinate seeded at both dual levels.
+    Jet<C, T2> q;
+    auto seed = [&](int k) {
+      T2 s(T1::variable(qv(k), k));
+      s.d[k] = T1(1.0);
+      return s;
+    };
+    for (int a = 0; a < r; ++a) q.p(a) = seed(a), q.dp(a) = seed(r + a), q.ddp(a) = seed(2 * r + a);
+    T2 phi = model.template lagrangian<T2>(q);
+    Eigen::Matrix<double, nq, (m > 0 ? m : 1)> chi_grad;
+    if constexpr (m > 0) {
+      const Vec<T2, m> chi = model.template constraints<T2>(q);
+      for (int c = 0; c < m; ++c) {
+        const double lambda = iv.w(Sch::multipliers(i) + c);
+        phi = phi + lambda * chi(c);
+        out.gradient(ny + i * m + c) = w * chi(c).v.v;
+        for (int k = 0; k < nq; ++k) chi_grad(k, c) = chi(c).v.d[k];
+      }
+    }
+    Vec<double, nq> g;
+    Eigen::Matrix<double, nq, nq> H;
+    for (int k = 0; k < nq; ++k) {
+      g(k) = phi.v.d[k];
+      for (int l = 0; l < nq; ++l) H(k, l) = phi.d[k].d[l];
+    }
+    // Mᵀ g, Mᵀ H M and Mᵀ ∇χ with M = K ⊗ I_r.
+    Eigen::Matrix<double, nq, ny> HM = Eigen::Matrix<double, nq, ny>::Zero();
+    for (int k = 0; k < 3; ++k)
+      for (int j = 0; j < cols; ++j) {
+        if (K(k, j) == 0.0) continue;
+        const double kj = K(k, j);
+        out.gradient.template segment<r>(j * r) += (w * kj) * g.template segment<r>(k * r);
+        HM.template middleCols<r>(j * r) += kj * H.template middleCols<r>(k * r);
+        if constexpr (m > 0)
+          out.hessian.template block<r, m>(j * r, ny + i * m) += (w * kj) * chi_grad.template middleRows<r>(k * r);
+      }
+    for (int k = 0; k < 3; ++k)
+      for (int j = 0; j < cols; ++j)
+        if (K(k, j) != 0.0)
+          out.hessian.template block<r, ny>(j * r, 0) += (w * K(k, j)) * HM.template middleRows<r>(k * r);
+  }
+  if constexpr (m > 0)  // the (λ, y) block
+    out.hessian.template bottomLeftCorner<nm, ny>() = out.hessian.template topRightCorner<ny, nm>().transpose();
+  (void)ne;
+  return out;
+}
+
+// The maps of the file comment. Rows: the node equations E (2r), interval n's bubble rows, its
+// multiplier rows (= the unknowns' layout without a group).
+template <class Sch>
+struct FlatStepMaps {
+  using D = FlatIntervalDerivatives<Sch>;
+  static constexpr int r = Sch::r, ny = D::ny, ne = D::ne, nz = Sch::unknowns, ns = Sch::state;
+  Eigen::Matrix<double, nz, ne> left, right;  // A_l, A_r
+  Eigen::Matrix<double, ne, nz> unknowns;     // S_z
+  Eigen::Matrix<double, ne, ns> base;         // S_b
+
+  explicit FlatStepMaps(double h) {
+    constexpr int x = 0, v = r, X2 = 2 * r, V1 = 3 * r;
+    left.setZero(), right.setZero(), unknowns.setZero(), base.setZero();
+    for (int a = 0; a < r; ++a) {
+      // Node n is the end of interval n-1 (X2 += e_x, V1 += e_v) and the base of interval n
+      // (x += h² e_x, v += h e_v, X2 -= e_x + e_v, V1 -= e_v); rows are ∂L~/∂e.
+      left(a, X2 + a) = 1, left(r + a, V1 + a) = 1;
+      right(a, x + a) = h * h, right(a, X2 + a) = -1;
+      right(r + a, v + a) = h, right(r + a, X2 + a) = -1, right(r + a, V1 + a) = -1;
+      // Interval n's base node: x + h v + h² X2 and v + h V1 of the state.
+      base(x + a, x + a) = 1, base(x + a, v + a) = h, base(x + a, X2 + a) = h * h;
+      base(v + a, v + a) = 1, base(v + a, V1 + a) = h;
+    }
+    // Interval n's own rows: ∂L~/∂a (bubbles, y indices 4r ..) and C (the λ entries).
+    for (int k = 0; k < ne - 4 * r; ++k) right(2 * r + k, 4 * r + k) = 1;
+    // The unknowns (X2, V1, bubbles, λ) are interval n's coordinates from 2r on.
+    for (int k = 0; k < nz; ++k) unknowns(2 * r + k, k) = 1;
+  }
+};
+
+// A flow's step-to-step carry: interval n's derivatives at its solution are interval n's as the
+// state of step n + 1 (d = 0 only; nothing is carried with a group).
+template <class Sch>
+struct StepCarry {
+  bool valid = false;
+  std::conditional_t<Sch::d == 0, FlatIntervalDerivatives<Sch>, char> interval{};
+};
+
+// evaluate_galerkin_step (galerkin_step.hpp) for d = 0: same arguments and results. `carry`, when
+// valid, holds the state's derivatives; on return it holds interval n's.
+template <class Sch, int NO>
+void evaluate_galerkin_step_flat(const typename Sch::Model& model, double h, const Interval<Sch, double>& state,
+                                 const Interval<Sch, double>& z, bool with_state,
+                                 const Vec<double, Sch::variation>* fixed, Vec<double, Sch::unknowns>& F,
+                                 Eigen::Matrix<double, Sch::unknowns, NO>& J, StepCarry<Sch>* carry = nullptr) {
+  constexpr int nz = Sch::unknowns, nv = Sch::variation;
+  constexpr bool state_cols = NO != nz;
+  const FlatStepMaps<Sch> maps(h);
+  Interval<Sch, double> right = z;
+  const Interval<Sch, double> b = next_interval_base(state, h);
+  right.x = b.x, right.v = b.v;
+  const FlatIntervalDerivatives<Sch> dr = flat_interval_derivatives<Sch>(model, right, h);
+  const double inv_h = 1.0 / h;
+  F.noalias() = inv_h * (maps.right * dr.gradient);
+  const Eigen::Matrix<double, nz, FlatStepMaps<Sch>::ne> AH = inv_h * (maps.right * dr.hessian);
+  J.template leftCols<nz>().noalias() = AH * maps.unknowns;
+  if constexpr (state_cols) J.template rightCols<NO - nz>().noalias() = AH * maps.base;
+  if (fixed) {
+    F.template head<nv>() += *fixed;
+  } else {
+    const FlatIntervalDerivatives<Sch> dl =
+        carry && carry->valid ? carry->interval : flat_interval_derivatives<Sch>(model, state, h);
+    F.noalias() += inv_h * (maps.left * dl.gradient);
+    if constexpr (state_cols)
+      if (with_state) J.template rightCols<NO - nz>().noalias() += inv_h * (maps.left * dl.hessian);
+  }
+  if (carry) {
+    carry->interval = dr;
+    carry->valid = true;
+  }
+}
+
+}  // namespace lpshoot
