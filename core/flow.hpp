@@ -127,18 +127,17 @@ class DiscreteFlow {
 
     FlowState<P> s = initial;
     Eigen::MatrixXd next;
-    // With sensitivities, each step's matrix at its solution comes with them; the next step's
-    // Newton iterates with it first (newton_solve, `previous`).
-    Eigen::Matrix<double, D::unknowns, D::unknowns> step_matrix;
-    bool have_step_matrix = false;
+    // With sensitivities, each step's exact matrix at its solution, factored: the next step's
+    // Newton iterates with it first (newton_solve). Without, every step evaluates its own.
+    ChordMatrix<D::unknowns> chord;
     for (int n = k; n <= N - k; ++n) {
       StepUnknowns<P> z;
-      if (!rep.add(solve_step(problem_, h_, s, n, options_, z, have_step_matrix ? &step_matrix : nullptr)))
+      if (!rep.add(solve_step(problem_, h_, s, n, options_, z, seed ? &chord : nullptr)))
         return out;
       if (seed) {
         // New state = shifted old state + z; the new rows come from the implicit function theorem.
         double condition = 0;
-        const Eigen::Matrix<double, D::unknowns, ns> dz = step_sensitivity(problem_, h_, s, z, &step_matrix, &condition);
+        const Eigen::Matrix<double, D::unknowns, ns> dz = step_sensitivity(problem_, h_, s, z, &chord, &condition);
         rep.max_condition = std::max(rep.max_condition, condition);
         if (!(condition <= options_.max_condition)) {  // regular at the predictor, not at the solution
           --rep.steps;
@@ -147,9 +146,9 @@ class DiscreteFlow {
           rep.message = "step n=" + std::to_string(n) + ": " + singular_step_reason(condition, options_.max_condition);
           return out;
         }
-        have_step_matrix = true;
         const Eigen::MatrixXd& S = out.sensitivity;
-        const Eigen::MatrixXd dzS = dz * S.topRows(ns);  // the state's rows (not the group element's)
+        // The state's rows (not the group element's); coefficient-based, cheaper than GEMM at these sizes.
+        const Eigen::MatrixXd dzS = dz.lazyProduct(S.topRows(ns));
         next.resize(S.rows(), S.cols());
         using FS = FlowState<P>;
         next.middleRows(FS::p_offset(0), (2 * k - 1) * r) = S.middleRows(FS::p_offset(1), (2 * k - 1) * r);

@@ -85,20 +85,18 @@ class GalerkinFlow {
     if (seed) out.sensitivity = *seed;
     Eigen::MatrixXd next;
     Interval<Sch, double> s = start;
-    // With sensitivities, each step's matrix at its solution comes with them; the next step's
-    // Newton iterates with it first (newton_solve, `previous`).
-    Eigen::Matrix<double, nz, nz> step_matrix;
-    bool have_step_matrix = false;
+    // With sensitivities, each step's exact matrix at its solution, factored: the next step's
+    // Newton iterates with it first (newton_solve). Without, every step evaluates its own.
+    ChordMatrix<nz> chord;
     StepCarry<Sch> carry;  // interval derivatives shared by consecutive steps
     for (int k = 1; k <= steps; ++k) {
       Interval<Sch, double> z;
-      if (!rep.add(solve_galerkin_step<Sch>(model_, h_, s, first_node + k, options_, z,
-                                            have_step_matrix ? &step_matrix : nullptr, &carry)))
+      if (!rep.add(solve_galerkin_step<Sch>(model_, h_, s, first_node + k, options_, z, seed ? &chord : nullptr, &carry)))
         return out;
       if (seed) {
         double condition = 0;
         const Eigen::Matrix<double, nz, ns> dz =
-            galerkin_step_sensitivity<Sch>(model_, h_, s, z, &step_matrix, &condition, &carry);
+            galerkin_step_sensitivity<Sch>(model_, h_, s, z, &chord, &condition, &carry);
         rep.max_condition = std::max(rep.max_condition, condition);
         if (!(condition <= options_.max_condition)) {  // regular at the predictor, not at the solution
           --rep.steps;
@@ -108,7 +106,6 @@ class GalerkinFlow {
                         singular_step_reason(condition, options_.max_condition);
           return out;
         }
-        have_step_matrix = true;
         const Eigen::MatrixXd& S = out.sensitivity;
         next.resize(S.rows(), S.cols());
         // The base node of interval n is the end of interval n-1.
@@ -117,7 +114,8 @@ class GalerkinFlow {
             S.middleRows(Sch::x_off, r) + h * S.middleRows(Sch::v_off, r) + (h * h) * S.middleRows(Sch::X2_off, r);
         next.middleRows(Sch::v_off, r) = S.middleRows(Sch::v_off, r) + h * S.middleRows(Sch::V1_off, r);
         next.middleRows(Sch::Om_off, d) = S.middleRows(Sch::Om_off, d) + h * S.middleRows(Sch::O1_off, d);
-        next.middleRows(Sch::X2_off, nz).noalias() = dz * S.topRows(ns);
+        // Coefficient-based: at these sizes (nz x ns times ns x seeds) GEMM's packing costs more than the product.
+        next.middleRows(Sch::X2_off, nz).noalias() = dz.lazyProduct(S.topRows(ns));
         if constexpr (d > 0) {
           if (with_group)  // g_n = g_{n-1} W_{n-1}:  δg_n = Ad_{W^{-1}} δg_{n-1} + h δW
             next.bottomRows(d) = G::Ad(G::inverse(s.W)) * S.bottomRows(d) + h * S.middleRows(Sch::W_off, d);

@@ -243,12 +243,12 @@ void apply_galerkin_correction(Interval<Sch, double>& z, const Vec<double, Sch::
 
 // Solves step n (interval n from interval n-1 = `state`) by Newton from the predictor "interval
 // n-1's unknowns"; on return z is interval n (its base node included).
-// `previous`: the step matrix of step n-1 at its solution, for chord iterations (newton_solve).
+// `chord`: a flow's factored step matrix, for chord iterations (newton_solve).
 // `carry`: the state's derivatives, when the flow has them (its part of E_n is read off them).
 template <class Sch>
 StepReport solve_galerkin_step(const typename Sch::Model& model, double h, const Interval<Sch, double>& state, int n,
                                const NewtonOptions& opt, Interval<Sch, double>& z,
-                               const Eigen::Matrix<double, Sch::unknowns, Sch::unknowns>* previous = nullptr,
+                               ChordMatrix<Sch::unknowns>* chord = nullptr,
                                const StepCarry<Sch>* carry = nullptr) {
   constexpr int r = Sch::r, d = Sch::d, nz = Sch::unknowns, nv = Sch::variation;
   z = state;
@@ -286,28 +286,30 @@ StepReport solve_galerkin_step(const typename Sch::Model& model, double h, const
         scale.template tail<Sch::aux>() = z.w.cwiseAbs();
         return scale;
       },
-      previous);
+      chord);
 }
 
 // dz/d(state) at a solved step (nz x ns), by the implicit function theorem. Optionally the step
-// matrix ∂F/∂z there (for the next step's chord iterations) and its 1-norm condition number (the
-// regularity check at the solution). `carry`: a flow's derivatives of the state from the step
+// matrix ∂F/∂z there, factored (for the next step's chord iterations), and its 1-norm condition
+// number (the regularity check at the solution). `carry`: a flow's derivatives of the state from the step
 // before, updated to this step's (galerkin_flat.hpp).
 template <class Sch>
 Eigen::Matrix<double, Sch::unknowns, Sch::state> galerkin_step_sensitivity(
     const typename Sch::Model& model, double h, const Interval<Sch, double>& state, const Interval<Sch, double>& z,
-    Eigen::Matrix<double, Sch::unknowns, Sch::unknowns>* step_matrix = nullptr, double* condition = nullptr,
-    StepCarry<Sch>* carry = nullptr) {
+    ChordMatrix<Sch::unknowns>* chord = nullptr, double* condition = nullptr, StepCarry<Sch>* carry = nullptr) {
   constexpr int nz = Sch::unknowns, ns = Sch::state;
   Vec<double, nz> F;
   Eigen::Matrix<double, nz, nz + ns> J;
   evaluate_galerkin_step<Sch, nz + ns>(model, h, state, z, true, nullptr, F, J, carry);
   const Eigen::Matrix<double, nz, nz> Jz = J.template leftCols<nz>();
   const Eigen::Matrix<double, nz, ns> Js = J.template rightCols<ns>();
-  const Eigen::PartialPivLU<Eigen::Matrix<double, nz, nz>> lu(Jz);
-  if (step_matrix) *step_matrix = Jz;
-  if (condition) *condition = condition_number_1(Jz, lu);
-  return -lu.solve(Js);
+  ChordMatrix<nz> own;
+  ChordMatrix<nz>& factored = chord ? *chord : own;
+  factored.lu.compute(Jz);
+  factored.condition = condition_number_1(Jz, factored.lu);
+  factored.valid = true;  // the flow stops at a singular one (condition)
+  if (condition) *condition = factored.condition;
+  return -factored.lu.solve(Js);
 }
 
 }  // namespace lpshoot

@@ -3,8 +3,10 @@
 //
 // Newton from a predictor with an exact Jacobian; after a Newton step, chord steps (same
 // factorization, residual only) are taken while they contract by 4x, else the Jacobian is
-// refreshed. The 1-norm condition number of the step matrix is the regularity diagnostic (paper
-// Proposition 2): above NewtonOptions::max_condition the step is reported singular, naming it.
+// refreshed. A flow with sensitivities carries each step's factored matrix at its solution to the
+// next step (ChordMatrix), which starts with chord steps on it. The 1-norm condition number of
+// every step matrix factored is the regularity diagnostic (paper Proposition 2): above
+// NewtonOptions::max_condition the step is reported singular, naming it.
 // Everything is fixed size: no allocation in the loop except the failure message.
 #pragma once
 
@@ -114,16 +116,28 @@ inline std::string singular_step_reason(double condition, double max_condition) 
          format_number(max_condition) + ")";
 }
 
+// A factored step matrix for chord iterations: the exact matrix of a flow's previous step at its
+// solution (the sensitivity computes and factors it anyway). Valid only when regular. Flows
+// without sensitivities do not carry one: chord-solved steps are accurate to the step tolerance
+// only, Newton-solved ones to roundoff, and the discrete momentum map adds up the difference
+// (bench/RESULTS.md, "Reusing Jacobians across steps and Newton iterations").
+template <int n>
+struct ChordMatrix {
+  Eigen::PartialPivLU<Eigen::Matrix<double, n, n>> lu;
+  double condition = 0;  // 1-norm condition number of the factored matrix
+  bool valid = false;
+};
+
 // Solves F(z) = 0 for a step with n unknowns. The callbacks:
 //   jacobian(F, J): F and ∂F/∂z at the current z;  residual(F): F only;
 //   correct(dz): z <- z ⊕ dz;  magnitude(): |z_i| for the convergence test (0 for group parts).
-// `previous`, when given, is the exact step matrix of a neighbouring step at its solution (a flow's
-// previous step, already checked regular there): the first iterations are chord steps with it,
-// and the exact Jacobian is evaluated only when they stop contracting by 4x (the Jacobian reuse
-// of implicit integrators; the converged z is the same, to the step tolerance).
+// `chord`, when given and valid, is a neighbouring step's factored matrix (ChordMatrix): the
+// first iterations are chord steps with it, and the exact Jacobian is evaluated only when they
+// stop contracting by 4x (the Jacobian reuse of implicit integrators; the converged z is the
+// same, to the step tolerance). A Jacobian evaluated here is left in `chord` for the next step.
 template <int n, class Jacobian, class Residual, class Correct, class Magnitude>
 StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian, Residual&& residual, Correct&& correct,
-                        Magnitude&& magnitude, const Eigen::Matrix<double, n, n>* previous = nullptr) {
+                        Magnitude&& magnitude, ChordMatrix<n>* chord = nullptr) {
   StepReport rep;
   rep.step = step;
   auto fail = [&](StepStatus st, const std::string& why) {
@@ -134,13 +148,11 @@ StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian,
   using Vn = Eigen::Matrix<double, n, 1>;
   Vn F;
   Eigen::Matrix<double, n, n> J;
-  Eigen::PartialPivLU<Eigen::Matrix<double, n, n>> lu;
-  bool refresh = true;
-  if (previous) {
-    lu.compute(*previous);
-    rep.condition = condition_number_1(*previous, lu);
-    refresh = !(rep.condition <= opt.max_condition);
-  }
+  ChordMatrix<n> own;
+  ChordMatrix<n>& factored = chord ? *chord : own;
+  auto& lu = factored.lu;
+  bool refresh = !(factored.valid && factored.condition <= opt.max_condition);
+  if (!refresh) rep.condition = factored.condition;
   double last_step = std::numeric_limits<double>::infinity();
   double last_residual = std::numeric_limits<double>::infinity();
   constexpr double eps = std::numeric_limits<double>::epsilon();
@@ -152,8 +164,9 @@ StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian,
         return fail(StepStatus::NonFinite, "the step equations evaluated to a non-finite number");
       lu.compute(J);
       rep.condition = condition_number_1(J, lu);
-      if (!(rep.condition <= opt.max_condition))
-        return fail(StepStatus::Singular, singular_step_reason(rep.condition, opt.max_condition));
+      factored.condition = rep.condition;
+      factored.valid = rep.condition <= opt.max_condition;
+      if (!factored.valid) return fail(StepStatus::Singular, singular_step_reason(rep.condition, opt.max_condition));
     } else {
       residual(F);
       if (!all_finite(F.data(), n)) return fail(StepStatus::NonFinite, "the step equations evaluated to a non-finite number");

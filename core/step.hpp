@@ -139,11 +139,10 @@ void apply_correction(StepUnknowns<P>& z, const Vec<double, Dims<P>::unknowns>& 
 
 // Solves step n by Newton (newton.hpp) from the predictor (linear extrapolation of p, previous
 // increment and multiplier). The z-independent windows are evaluated once per step.
-// `previous`: the step matrix of step n-1 at its solution, for chord iterations (newton_solve).
+// `chord`: a flow's factored step matrix, for chord iterations (newton_solve).
 template <class P>
 StepReport solve_step(const P& problem, double h, const FlowState<P>& s, int n, const NewtonOptions& opt,
-                      StepUnknowns<P>& z,
-                      const Eigen::Matrix<double, Dims<P>::unknowns, Dims<P>::unknowns>* previous = nullptr) {
+                      StepUnknowns<P>& z, ChordMatrix<Dims<P>::unknowns>* chord = nullptr) {
   using D = Dims<P>;
   constexpr int k = D::k, nz = D::unknowns;
   z.p = 2.0 * s.p[2 * k - 1] - s.p[2 * k - 2];
@@ -171,16 +170,16 @@ StepReport solve_step(const P& problem, double h, const FlowState<P>& s, int n, 
         scale.template tail<D::m>() = z.lam.cwiseAbs();
         return scale;
       },
-      previous);
+      chord);
 }
 
 // dz/d(state) at a solved step (nz x state), by the implicit function theorem. Optionally the
-// step matrix ∂F/∂z there (for the next step's chord iterations) and its 1-norm condition number
-// (the regularity check at the solution).
+// step matrix ∂F/∂z there, factored (for the next step's chord iterations), and its 1-norm
+// condition number (the regularity check at the solution).
 template <class P>
 Eigen::Matrix<double, Dims<P>::unknowns, Dims<P>::state> step_sensitivity(
     const P& problem, double h, const FlowState<P>& s, const StepUnknowns<P>& z,
-    Eigen::Matrix<double, Dims<P>::unknowns, Dims<P>::unknowns>* step_matrix = nullptr, double* condition = nullptr) {
+    ChordMatrix<Dims<P>::unknowns>* chord = nullptr, double* condition = nullptr) {
   using D = Dims<P>;
   constexpr int nz = D::unknowns, ns = D::state;
   Vec<double, nz> F;
@@ -188,10 +187,13 @@ Eigen::Matrix<double, Dims<P>::unknowns, Dims<P>::state> step_sensitivity(
   evaluate_step<P, nz + ns>(problem, h, s, z, true, nullptr, F, J);
   const Eigen::Matrix<double, nz, nz> Jz = J.template leftCols<nz>();
   const Eigen::Matrix<double, nz, ns> Js = J.template rightCols<ns>();
-  const Eigen::PartialPivLU<Eigen::Matrix<double, nz, nz>> lu(Jz);
-  if (step_matrix) *step_matrix = Jz;
-  if (condition) *condition = condition_number_1(Jz, lu);
-  return -lu.solve(Js);
+  ChordMatrix<nz> own;
+  ChordMatrix<nz>& factored = chord ? *chord : own;
+  factored.lu.compute(Jz);
+  factored.condition = condition_number_1(Jz, factored.lu);
+  factored.valid = true;  // the flow stops at a singular one (condition)
+  if (condition) *condition = factored.condition;
+  return -factored.lu.solve(Js);
 }
 
 }  // namespace lpshoot

@@ -1,0 +1,114 @@
+// The step solver's Jacobian reuse (core/newton.hpp), as flows with sensitivities use it: a
+// factored matrix carried from a neighbouring step (ChordMatrix) saves Jacobian evaluations,
+// lands on the solution a fresh Newton finds, is refreshed when its chord steps stop contracting,
+// and a singular matrix is reported and never carried.
+#include <lpshoot/core/newton.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace lpshoot;
+
+namespace {
+using V3 = Eigen::Vector3d;
+using M3 = Eigen::Matrix3d;
+
+// F(z) = A z + c z³ (componentwise) - b: a small nonlinear "step".
+struct CubicSystem {
+  M3 A;
+  double c = 0.1;
+  V3 b;
+  V3 F(const V3& z) const { return A * z + c * z.array().cube().matrix() - b; }
+  M3 J(const V3& z) const {
+    M3 j = A;
+    j.diagonal() += (3 * c) * z.array().square().matrix();
+    return j;
+  }
+};
+
+struct Solve {
+  StepReport report;
+  V3 z;
+  int jacobians = 0;
+};
+
+Solve solve(const CubicSystem& sys, V3 z0, ChordMatrix<3>* chord, NewtonOptions opt = {}) {
+  Solve out;
+  out.z = z0;
+  out.report = newton_solve<3>(
+      7, opt,
+      [&](V3& F, M3& J) {
+        ++out.jacobians;
+        F = sys.F(out.z);
+        J = sys.J(out.z);
+      },
+      [&](V3& F) { F = sys.F(out.z); }, [&](const V3& dz) { out.z += dz; }, [&] { return V3(out.z.cwiseAbs()); },
+      chord);
+  return out;
+}
+
+CubicSystem base_system() {
+  CubicSystem s;
+  s.A << 4, 1, 0, 1, 3, 1, 0, 1, 5;
+  s.b = V3(1, 2, 3);
+  return s;
+}
+}  // namespace
+
+TEST(NewtonChord, ANeighboursMatrixSavesJacobiansAndLandsOnTheSameSolution) {
+  const CubicSystem first = base_system();
+  ChordMatrix<3> chord;
+  const Solve a = solve(first, V3::Zero(), &chord);
+  ASSERT_EQ(a.report.status, StepStatus::Converged) << a.report.message;
+  ASSERT_TRUE(chord.valid);
+  EXPECT_GE(a.jacobians, 1);
+  // The next "step": slightly different data, from the previous solution as predictor.
+  CubicSystem next = first;
+  next.b += V3(1e-3, -2e-3, 1e-3);
+  const Solve fresh = solve(next, a.z, nullptr);
+  const Solve reused = solve(next, a.z, &chord);
+  ASSERT_EQ(fresh.report.status, StepStatus::Converged);
+  ASSERT_EQ(reused.report.status, StepStatus::Converged) << reused.report.message;
+  EXPECT_EQ(fresh.jacobians, 1);
+  EXPECT_EQ(reused.jacobians, 0);  // chord steps with the neighbour's matrix contract fast enough
+  EXPECT_LT((reused.z - fresh.z).lpNorm<Eigen::Infinity>(), 1e-11);
+  EXPECT_LT(next.F(reused.z).lpNorm<Eigen::Infinity>(), 1e-11);
+  EXPECT_DOUBLE_EQ(reused.report.condition, chord.condition);
+}
+
+TEST(NewtonChord, AMatrixWhoseChordStepsDoNotContractIsRefreshed) {
+  const CubicSystem sys = base_system();
+  ChordMatrix<3> chord;
+  // A poor carried matrix: the exact one of a far-away point (z = (3, -3, 3): cubic terms dominate).
+  const V3 far(3, -3, 3);
+  chord.lu.compute(sys.J(far));
+  chord.condition = condition_number_1(M3(sys.J(far)), chord.lu);
+  chord.valid = true;
+  const Solve s = solve(sys, V3::Zero(), &chord);
+  ASSERT_EQ(s.report.status, StepStatus::Converged) << s.report.message;
+  EXPECT_GE(s.jacobians, 1);
+  EXPECT_LT(sys.F(s.z).lpNorm<Eigen::Infinity>(), 1e-11);
+  // The carried matrix is now one evaluated here, near the solution (an iterate away from it).
+  const M3 carried = chord.lu.reconstructedMatrix();
+  EXPECT_LT((carried - sys.J(s.z)).lpNorm<Eigen::Infinity>(), 0.02 * (sys.J(far) - sys.J(s.z)).lpNorm<Eigen::Infinity>());
+}
+
+TEST(NewtonChord, ASingularMatrixIsReportedAndNotCarried) {
+  CubicSystem sys = base_system();
+  sys.A.setZero();  // J(0) = 0
+  ChordMatrix<3> chord;
+  const Solve s = solve(sys, V3::Zero(), &chord);
+  EXPECT_EQ(s.report.status, StepStatus::Singular);
+  EXPECT_NE(s.report.message.find("step n=7"), std::string::npos) << s.report.message;
+  EXPECT_FALSE(chord.valid);
+  // A carried matrix above the condition limit is not used: the step evaluates its own.
+  const CubicSystem ok = base_system();
+  chord.valid = true;
+  chord.condition = 1e20;
+  const Solve t = solve(ok, V3::Zero(), &chord);
+  ASSERT_EQ(t.report.status, StepStatus::Converged) << t.report.message;
+  EXPECT_GE(t.jacobians, 1);
+  EXPECT_TRUE(chord.valid);
+  EXPECT_LT(chord.condition, 1e3);
+}
