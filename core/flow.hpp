@@ -4,6 +4,7 @@
 // with respect to any set of directions of the initial state.
 #pragma once
 
+#include "degree.hpp"
 #include "step.hpp"
 
 #include <Eigen/Core>
@@ -88,10 +89,15 @@ class DiscreteFlow {
  public:
   using D = Dims<P>;
   DiscreteFlow(const P& problem, double h, NewtonOptions options = {})
-      : problem_(problem), h_(h), options_(options) {}
+      : problem_(problem),
+        h_(h),
+        options_(options),
+        affine_(options.reuse_constant_matrix && discrete_problem_is_quadratic(problem, h)) {}
 
   const P& problem() const { return problem_; }
   double h() const { return h_; }
+  // The step equations are affine with one matrix for every step (degree.hpp), factored once.
+  bool affine() const { return affine_; }
 
   // Runs to node N (steps n = k .. N-k). `seed` (state x q, optional) gives the initial
   // directions whose sensitivity is propagated to the final state.
@@ -128,16 +134,23 @@ class DiscreteFlow {
     FlowState<P> s = initial;
     Eigen::MatrixXd next;
     // With sensitivities, each step's exact matrix at its solution, factored: the next step's
-    // Newton iterates with it first (newton_solve). Without, every step evaluates its own.
+    // Newton iterates with it first (newton_solve). Without, every step evaluates its own, unless
+    // the steps are affine: then the matrix factored at the first step serves every step (its
+    // chord step is the Newton step), and so does the sensitivity dz/d(state).
     ChordMatrix<D::unknowns> chord;
+    ChordMatrix<D::unknowns>* const chord_used = seed || affine_ ? &chord : nullptr;
+    Eigen::Matrix<double, D::unknowns, ns> dz;
+    double condition = 0;  // dz's step matrix's
+    bool dz_current = false;
     for (int n = k; n <= N - k; ++n) {
       StepUnknowns<P> z;
-      if (!rep.add(solve_step(problem_, h_, s, n, options_, z, seed ? &chord : nullptr)))
-        return out;
+      if (!rep.add(solve_step(problem_, h_, s, n, options_, z, chord_used))) return out;
       if (seed) {
         // New state = shifted old state + z; the new rows come from the implicit function theorem.
-        double condition = 0;
-        const Eigen::Matrix<double, D::unknowns, ns> dz = step_sensitivity(problem_, h_, s, z, &chord, &condition);
+        if (!dz_current) {
+          dz = step_sensitivity(problem_, h_, s, z, &chord, &condition);
+          dz_current = affine_;
+        }
         rep.max_condition = std::max(rep.max_condition, condition);
         if (!(condition <= options_.max_condition)) {  // regular at the predictor, not at the solution
           --rep.steps;
@@ -187,6 +200,7 @@ class DiscreteFlow {
   P problem_;
   double h_;
   NewtonOptions options_;
+  bool affine_;
 };
 
 // Moves a state along tangent coordinates: p += δp, g~ <- g~ exp(δ), λ += δλ.

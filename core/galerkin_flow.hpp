@@ -3,6 +3,7 @@
 // a trajectory: nodes, the group element, the discrete momentum map, node controls.
 #pragma once
 
+#include "degree.hpp"
 #include "galerkin_step.hpp"
 
 #include <algorithm>
@@ -48,10 +49,13 @@ class GalerkinFlow {
  public:
   using Model = typename Sch::Model;
   using G = typename Sch::Group;
-  GalerkinFlow(const Model& model, double h, NewtonOptions options = {}) : model_(model), h_(h), options_(options) {}
+  GalerkinFlow(const Model& model, double h, NewtonOptions options = {})
+      : model_(model), h_(h), options_(options), affine_(options.reuse_constant_matrix && model_is_quadratic(model)) {}
 
   const Model& model() const { return model_; }
   double h() const { return h_; }
+  // The step equations are affine with one matrix for every step (degree.hpp), factored once.
+  bool affine() const { return affine_; }
 
   // Takes `steps` steps from interval `start` (whose base node is node `first_node`, for
   // messages), g at its base node = g_start. `seed` (Sch::state or Sch::state + d rows) gives
@@ -86,17 +90,25 @@ class GalerkinFlow {
     Eigen::MatrixXd next;
     Interval<Sch, double> s = start;
     // With sensitivities, each step's exact matrix at its solution, factored: the next step's
-    // Newton iterates with it first (newton_solve). Without, every step evaluates its own.
+    // Newton iterates with it first (newton_solve). Without, every step evaluates its own, unless
+    // the steps are affine: then the matrix factored at the first step serves every step (its
+    // chord step is the Newton step), and so does the sensitivity dz/d(state).
     ChordMatrix<nz> chord;
-    StepCarry<Sch> carry;  // interval derivatives shared by consecutive steps
+    ChordMatrix<nz>* const chord_used = seed || affine_ ? &chord : nullptr;
+    StepCarry<Sch> carry;  // interval derivatives shared by consecutive steps (stale if dz is reused)
+    StepCarry<Sch>* const carry_used = affine_ ? nullptr : &carry;
+    Eigen::Matrix<double, nz, ns> dz;
+    double condition = 0;  // dz's step matrix's
+    bool dz_current = false;
     for (int k = 1; k <= steps; ++k) {
       Interval<Sch, double> z;
-      if (!rep.add(solve_galerkin_step<Sch>(model_, h_, s, first_node + k, options_, z, seed ? &chord : nullptr, &carry)))
+      if (!rep.add(solve_galerkin_step<Sch>(model_, h_, s, first_node + k, options_, z, chord_used, carry_used)))
         return out;
       if (seed) {
-        double condition = 0;
-        const Eigen::Matrix<double, nz, ns> dz =
-            galerkin_step_sensitivity<Sch>(model_, h_, s, z, &chord, &condition, &carry);
+        if (!dz_current) {
+          dz = galerkin_step_sensitivity<Sch>(model_, h_, s, z, &chord, &condition, carry_used);
+          dz_current = affine_;
+        }
         rep.max_condition = std::max(rep.max_condition, condition);
         if (!(condition <= options_.max_condition)) {  // regular at the predictor, not at the solution
           --rep.steps;
@@ -136,6 +148,7 @@ class GalerkinFlow {
   Model model_;
   double h_;
   NewtonOptions options_;
+  bool affine_;
 };
 
 // Moves an interval along its tangent coordinates (Galerkin offsets; W <- W exp(h δ)).

@@ -39,6 +39,9 @@ struct NewtonOptions {
   double step_tolerance = 1e-12;
   // A step whose ∂F/∂z has a larger condition estimate is reported singular.
   double max_condition = 1e13;
+  // Problems whose step equations are affine with a constant matrix (core/degree.hpp) factor it
+  // once per flow: the chord step is then the Newton step. False: every step evaluates its own.
+  bool reuse_constant_matrix = true;
 };
 
 enum class FlowStatus { Ok, NotConverged, Singular, NonFinite, InvalidInput };
@@ -127,6 +130,18 @@ struct ChordMatrix {
   double condition = 0;  // 1-norm condition number of the factored matrix
   bool valid = false;
 };
+
+// dz/d(state) = -(∂F/∂z)^{-1} ∂F/∂(state) at a solved step (the implicit function theorem),
+// leaving ∂F/∂z factored in `factored` with its 1-norm condition number (the regularity check at
+// the solution; a flow stops at a singular one, so the matrix is marked valid for chord steps).
+template <int nz, int ns>
+Eigen::Matrix<double, nz, ns> implicit_sensitivity(const Eigen::Matrix<double, nz, nz>& Jz,
+                                                   const Eigen::Matrix<double, nz, ns>& Js, ChordMatrix<nz>& factored) {
+  factored.lu.compute(Jz);
+  factored.condition = condition_number_1(Jz, factored.lu);
+  factored.valid = true;
+  return -factored.lu.solve(Js);
+}
 
 // Solves F(z) = 0 for a step with n unknowns. The callbacks:
 //   jacobian(F, J): F and ∂F/∂z at the current z;  residual(F): F only;

@@ -189,11 +189,9 @@ Eigen::Matrix<double, Dims<P>::unknowns, Dims<P>::state> step_sensitivity(
   const Eigen::Matrix<double, nz, ns> Js = J.template rightCols<ns>();
   ChordMatrix<nz> own;
   ChordMatrix<nz>& factored = chord ? *chord : own;
-  factored.lu.compute(Jz);
-  factored.condition = condition_number_1(Jz, factored.lu);
-  factored.valid = true;  // the flow stops at a singular one (condition)
+  const Eigen::Matrix<double, nz, ns> dz = implicit_sensitivity<nz, ns>(Jz, Js, factored);
   if (condition) *condition = factored.condition;
-  return -factored.lu.solve(Js);
+  return dz;
 }
 
 }  // namespace lpshoot

@@ -1,0 +1,226 @@
+// Problems whose step equations are affine (core/degree.hpp): the degree probe tells them from
+// the others, and their flows, which factor one step matrix for the whole flow and reuse the
+// step's sensitivity, give the same trajectory and sensitivities as flows that evaluate and
+// factor the exact matrix at every step (paper scheme and Galerkin), the sensitivities also
+// against central differences, which are exact up to rounding for an affine flow.
+#include <lpshoot/problems/beanie.hpp>
+#include <lpshoot/problems/electron_bvp.hpp>
+
+#include <gtest/gtest.h>
+
+using namespace lpshoot;
+using namespace lpshoot::problems;
+
+namespace {
+
+// ℓ = ½ |p''|² + c p₁ p₂, χ = p'₁ - 1: quadratic with a linear constraint.
+struct LinearConstraint {
+  using Group = Trivial;
+  static constexpr int shape_dim = 2;
+  static constexpr int num_constraints = 1;
+  double c = 0.3;
+  template <class T>
+  T lagrangian(const Jet<LinearConstraint, T>& q) const {
+    return 0.5 * q.ddp.squaredNorm() + c * q.p(0) * q.p(1);
+  }
+  template <class T>
+  Vec<T, 1> constraints(const Jet<LinearConstraint, T>& q) const {
+    return Vec<T, 1>(q.dp(0) - 1.0);
+  }
+};
+
+// The same with the unit-speed constraint χ = ½ (|p'|² - 1): not affine.
+struct QuadraticConstraint : LinearConstraint {
+  template <class T>
+  T lagrangian(const Jet<QuadraticConstraint, T>& q) const {
+    return 0.5 * q.ddp.squaredNorm();
+  }
+  template <class T>
+  Vec<T, 1> constraints(const Jet<QuadraticConstraint, T>& q) const {
+    return Vec<T, 1>(0.5 * (q.dp.squaredNorm() - 1.0));
+  }
+};
+
+// A quadratic on each side of p₁ = 0, chosen by a branch: piecewise, not affine.
+struct Branching {
+  using Group = Trivial;
+  static constexpr int shape_dim = 1;
+  static constexpr int num_constraints = 0;
+  template <class T>
+  T lagrangian(const Jet<Branching, T>& q) const {
+    const T stiffness = value(q.p(0)) > 0 ? T(1.0) : T(2.0);
+    return 0.5 * q.ddp(0) * q.ddp(0) + stiffness * q.p(0) * q.p(0);
+  }
+};
+
+// ½ |p''|² / m + √(1 + p'²): the root is not a polynomial.
+struct WithRoot {
+  using Group = Trivial;
+  static constexpr int shape_dim = 1;
+  static constexpr int num_constraints = 0;
+  double m = 2.0;
+  template <class T>
+  T lagrangian(const Jet<WithRoot, T>& q) const {
+    using std::sqrt;
+    return 0.5 * q.ddp(0) * q.ddp(0) / m + sqrt(1.0 + q.dp(0) * q.dp(0));
+  }
+};
+
+ElectronModel nonlinear_electron() {
+  ElectronModel e;
+  e.potential = 0.5, e.quartic = 0.125;  // METHOD.md §9's nonlinear electron-type problem
+  return e;
+}
+
+NewtonOptions every_step() {
+  NewtonOptions o;
+  o.reuse_constant_matrix = false;
+  return o;
+}
+
+// Largest relative difference of two matrices (scale: the larger entry of `a`, at least 1).
+double relative_difference(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return (a - b).lpNorm<Eigen::Infinity>() / std::max(1.0, a.lpNorm<Eigen::Infinity>());
+}
+
+template <class Sch>
+Interval<Sch, double> electron_start() {
+  Interval<Sch, double> iv;
+  iv.x << 1.0, 0.0, 0.5;
+  iv.v << 0.0, 1.0, -0.2;
+  iv.X2 << -0.2, 0.1, 0.05;
+  iv.V1 << -0.4, 0.3, 0.1;
+  for (int a = 0; a < Sch::aux; ++a) iv.w(a) = 0.01 * (a + 1);
+  return iv;
+}
+
+// The affine Galerkin flow against one that factors the exact matrix at every step, and its
+// sensitivity against central differences (exact for an affine map, up to rounding).
+template <class Sch>
+void expect_affine_galerkin_flow(double h, int steps) {
+  constexpr int ns = Sch::state;
+  const ElectronModel e;
+  const GalerkinFlow<Sch> affine(e, h), newton(e, h, every_step());
+  ASSERT_TRUE(affine.affine());
+  ASSERT_FALSE(newton.affine());
+  const auto start = electron_start<Sch>();
+  const Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(ns, ns);
+  const auto a = affine.run(start, steps, &seed), b = newton.run(start, steps, &seed);
+  ASSERT_TRUE(a.report.ok()) << a.report.message;
+  ASSERT_TRUE(b.report.ok()) << b.report.message;
+  // Both solve every step to roundoff; what differs is rounding, amplified by the flow at most
+  // like its sensitivity: 1e-14 per step times |S| bounds it (a chord solve to the step
+  // tolerance instead of roundoff would leave ~1e-12 per step).
+  const double amplification = std::max(1.0, b.sensitivity.template lpNorm<Eigen::Infinity>());
+  double worst_state = 0;
+  for (int n = 0; n <= steps; ++n)
+    worst_state = std::max(worst_state, state_difference(a.trajectory.intervals[n], b.trajectory.intervals[n], h)
+                                                .template lpNorm<Eigen::Infinity>());
+  const double worst_sensitivity = relative_difference(b.sensitivity, a.sensitivity);
+  // Central differences of an affine map: no truncation, rounding ~ u |S| |state| / eps.
+  const double eps = 1e-3;
+  double worst_fd = 0;
+  for (int j = 0; j < ns; ++j) {
+    auto end_after = [&](double s) {
+      Vec<double, ns> delta = Vec<double, ns>::Zero();
+      delta(j) = s;
+      const auto r = affine.run(retract<Sch>(start, delta, h), steps, nullptr);
+      EXPECT_TRUE(r.report.ok()) << r.report.message;
+      return Vec<double, ns>(state_difference(r.trajectory.intervals.back(), a.trajectory.intervals.back(), h));
+    };
+    const Vec<double, ns> fd = (end_after(eps) - end_after(-eps)) / (2 * eps);
+    worst_fd = std::max(worst_fd, (a.sensitivity.col(j) - fd).template lpNorm<Eigen::Infinity>() / amplification);
+  }
+  std::printf("degree %d, h = %g, %d steps (|S| = %.1e): affine vs Newton: states %.1e, sensitivity %.1e; "
+              "sensitivity vs central differences %.1e\n",
+              Sch::degree, h, steps, amplification, worst_state, worst_sensitivity, worst_fd);
+  EXPECT_LT(worst_state, 1e-14 * steps * amplification);
+  EXPECT_LT(worst_sensitivity, 1e-15 * steps);
+  EXPECT_LT(worst_fd, 1e-8);
+}
+
+}  // namespace
+
+TEST(DegreeProbe, CountsPolynomialDegrees) {
+  const Degree x = Degree::variable(0.5), y = Degree::variable(-2.0), c(3.0);
+  EXPECT_EQ((x * y + c * x).deg, 2);
+  EXPECT_EQ((x * x * x).deg, 3);
+  EXPECT_EQ((Degree(0.0) * x * x * x + x).deg, 1);  // a zero coefficient removes the term
+  EXPECT_EQ(pow(x, 2.0).deg, 2);
+  EXPECT_EQ(pow(x, 0.5).deg, Degree::non_polynomial);
+  EXPECT_EQ((x / c).deg, 1);
+  EXPECT_EQ((c / x).deg, Degree::non_polynomial);
+  EXPECT_EQ(sin(c).deg, 0);
+  EXPECT_EQ(cos(x).deg, Degree::non_polynomial);
+  EXPECT_DOUBLE_EQ((x * y + c * x).v, 0.5 * -2.0 + 3.0 * 0.5);
+}
+
+TEST(DegreeProbe, TellsAffineStepsFromOthers) {
+  EXPECT_TRUE(model_is_quadratic(ElectronModel{}));
+  EXPECT_FALSE(model_is_quadratic(nonlinear_electron()));
+  EXPECT_TRUE(model_is_quadratic(LinearConstraint{}));
+  EXPECT_FALSE(model_is_quadratic(QuadraticConstraint{}));
+  EXPECT_FALSE(model_is_quadratic(Branching{}));
+  EXPECT_FALSE(model_is_quadratic(WithRoot{}));
+  EXPECT_FALSE(model_is_quadratic(BeanieModel{}));  // a group: never affine here
+  EXPECT_TRUE(discrete_problem_is_quadratic(Electron{}, 0.01));
+  EXPECT_FALSE(discrete_problem_is_quadratic(BeanieControl{}, 0.01));
+  // The flows follow the probe and the option.
+  using Flow = GalerkinFlow<Galerkin<ElectronModel, 3>>;
+  EXPECT_TRUE(Flow(ElectronModel{}, 0.1).affine());
+  EXPECT_FALSE(Flow(nonlinear_electron(), 0.1).affine());
+  EXPECT_FALSE(Flow(ElectronModel{}, 0.1, every_step()).affine());
+  EXPECT_TRUE(DiscreteFlow<Electron>(Electron{}, 0.1).affine());
+  EXPECT_FALSE(DiscreteFlow<Electron>(Electron{}, 0.1, every_step()).affine());
+}
+
+TEST(AffineFlows, GalerkinElectronEqualsNewtonAtEveryStep) {
+  expect_affine_galerkin_flow<Galerkin<ElectronModel, 3>>(0.01, 300);
+  expect_affine_galerkin_flow<Galerkin<ElectronModel, 4>>(0.02, 150);
+}
+
+TEST(AffineFlows, GalerkinWithLinearConstraintEqualsNewtonAtEveryStep) {
+  using Sch = Galerkin<LinearConstraint, 3>;
+  constexpr int ns = Sch::state;
+  Interval<Sch, double> start;
+  start.x << 0.3, -0.2, start.v << 1.0, 0.5, start.X2 << 0.0, 0.1, start.V1 << 0.0, -0.2;
+  start.w.setConstant(0.05);
+  const GalerkinFlow<Sch> affine(LinearConstraint{}, 0.05), newton(LinearConstraint{}, 0.05, every_step());
+  ASSERT_TRUE(affine.affine());
+  const Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(ns, ns);
+  const auto a = affine.run(start, 100, &seed), b = newton.run(start, 100, &seed);
+  ASSERT_TRUE(a.report.ok()) << a.report.message;
+  ASSERT_TRUE(b.report.ok()) << b.report.message;
+  const double amplification = std::max(1.0, b.sensitivity.lpNorm<Eigen::Infinity>());
+  const double states = state_difference(a.trajectory.intervals.back(), b.trajectory.intervals.back(), 0.05)
+                            .lpNorm<Eigen::Infinity>();
+  std::printf("linear constraint, 100 steps (|S| = %.1e): states %.1e, sensitivity %.1e\n", amplification, states,
+              relative_difference(b.sensitivity, a.sensitivity));
+  EXPECT_LT(states, 1e-13 * amplification);
+  EXPECT_LT(relative_difference(b.sensitivity, a.sensitivity), 1e-13);
+  // The constraint p'₁ = 1 holds at every node.
+  for (int n = 0; n <= 100; ++n) EXPECT_NEAR(a.trajectory.v(n)(0), 1.0, 1e-12) << "node " << n;
+}
+
+TEST(AffineFlows, PaperElectronEqualsNewtonAtEveryStep) {
+  const Electron e;
+  const double h = 0.01;
+  const int N = 300;
+  FlowState<Electron> s;
+  const Eigen::Vector3d x0(1, 0, 0.5), v0(0, 1, -0.2), a0(0.3, -0.1, 0.2);
+  for (int i = 0; i < 4; ++i) s.p[i] = x0 + i * h * v0 + 0.5 * (i * h) * (i * h) * a0;
+  constexpr int ns = Dims<Electron>::state;
+  const Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(ns, ns);
+  const auto a = DiscreteFlow<Electron>(e, h).run(s, N, &seed);
+  const auto b = DiscreteFlow<Electron>(e, h, every_step()).run(s, N, &seed);
+  ASSERT_TRUE(a.report.ok()) << a.report.message;
+  ASSERT_TRUE(b.report.ok()) << b.report.message;
+  const double amplification = std::max(1.0, b.sensitivity.lpNorm<Eigen::Infinity>());
+  double states = 0;
+  for (int n = 0; n <= N; ++n)
+    states = std::max(states, (a.trajectory.p[n] - b.trajectory.p[n]).lpNorm<Eigen::Infinity>());
+  std::printf("paper electron, %d steps (|S| = %.1e): states %.1e, sensitivity %.1e\n", N, amplification, states,
+              relative_difference(b.sensitivity, a.sensitivity));
+  EXPECT_LT(states, 1e-14 * N * amplification);
+  EXPECT_LT(relative_difference(b.sensitivity, a.sensitivity), 1e-15 * N);
+}
