@@ -109,14 +109,15 @@ double inverse_one_norm_estimate(LU& lu, int n) {  // non-const: Eigen's transpo
 }
 }  // namespace detail
 
-// Structured version, for a sparse J: the same equilibration and flush; rank by sparse QR
-// (a column whose remaining norm falls below `tolerance`, i.e. tolerance times the unit scale of
-// the equilibrated columns, is rank deficient; natural column order: the shooting Jacobian is
-// banded, and its Householder vectors stay within the band, O(N) in all, where COLAMD's order
-// filled Q like S^2 and took 75% of a 4800-unknown solve); the condition
-// by Hager's 1-norm estimate on a sparse LU; the dependent conditions from the trailing columns
-// of Q, a basis of the left null space. Singular values (a dense SVD) only for systems of at
-// most `svd_limit` unknowns; a larger deficient system gets the dependent conditions without them.
+// Structured version, for a sparse J: the same equilibration and flush; the condition by
+// Hager's 1-norm estimate on a sparse LU; the rank by sparse QR, when the condition allows a
+// deficiency (a column whose remaining norm falls below `tolerance`, i.e. tolerance times the
+// unit scale of the equilibrated columns, is rank deficient; natural column order: the shooting
+// Jacobian is banded and its Householder vectors stay within the band, where COLAMD's order
+// filled Q like S^2 and took 75% of a 4800-unknown solve); the dependent conditions from the
+// trailing columns of Q, a basis of the left null space. Singular values (a dense SVD) only for
+// systems of at most `svd_limit` unknowns; a larger deficient system gets the dependent
+// conditions without them.
 inline RankDiagnosis diagnose_rank(Eigen::SparseMatrix<double, Eigen::ColMajor, int> J, const std::vector<std::string>& names,
                                    double tolerance, int svd_limit = 500) {
   using Sparse = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
@@ -142,19 +143,31 @@ inline RankDiagnosis diagnose_rank(Eigen::SparseMatrix<double, Eigen::ColMajor, 
     }
   J.prune(0.0);
   const int n = static_cast<int>(J.cols());
-  Eigen::SparseQR<Sparse, Eigen::NaturalOrdering<int>> qr;
-  qr.setPivotThreshold(tolerance);
-  qr.compute(J);
-  out.rank = qr.info() == Eigen::Success ? static_cast<int>(qr.rank()) : 0;
   Eigen::SparseLU<Sparse, Eigen::COLAMDOrdering<int>> lu;
   lu.compute(J);
   double norm1 = 0;
   for (int c = 0; c < n; ++c) norm1 = std::max(norm1, J.col(c).cwiseAbs().sum());
   out.condition = INFINITY;
+  double inverse_norm1 = INFINITY;
   if (lu.info() == Eigen::Success) {
-    const double c = norm1 * detail::inverse_one_norm_estimate(lu, n);
+    inverse_norm1 = detail::inverse_one_norm_estimate(lu, n);
+    const double c = norm1 * inverse_norm1;
     if (std::isfinite(c)) out.condition = c;
   }
+  // The QR runs only when it can find a deficiency: its test (a column's norm, orthogonalized
+  // against the columns before it, below `tolerance`) cannot fire when σ_min(J) > tolerance, and
+  // σ_min(J) >= 1 / (√n |J⁻¹|₁). Hager's estimate of |J⁻¹|₁ is a lower bound, within a small
+  // factor in practice: with a margin of 100, a J it finds well conditioned is full rank. (Eigen's
+  // SparseQR resets work arrays of the full size at every column, O(n²) in all: 14% of an
+  // electron solve at N = 10⁶, where the condition is ~1e4.)
+  if (std::sqrt(static_cast<double>(n)) * inverse_norm1 * tolerance * 100 < 1) {
+    out.rank = n;
+    return out;
+  }
+  Eigen::SparseQR<Sparse, Eigen::NaturalOrdering<int>> qr;
+  qr.setPivotThreshold(tolerance);
+  qr.compute(J);
+  out.rank = qr.info() == Eigen::Success ? static_cast<int>(qr.rank()) : 0;
   if (out.rank >= n) return out;
   if (n <= svd_limit) {
     const Eigen::MatrixXd dense(J);

@@ -1,4 +1,5 @@
-// KINSOL backend: exact Newton (KINSetMaxSetupCalls(1): a fresh Jacobian every iteration) with
+// KINSOL backend: exact Newton (KINSetMaxSetupCalls(1): a fresh Jacobian every iteration; for an
+// affine F, SolverOptions::affine, one Jacobian for the full steps, whose Newton steps it gives) with
 // KLU, SUNDIALS' sparse direct solver (compressed sparse columns; fill-reducing ordering, partial
 // pivoting, refactorization on the same pattern), in two phases:
 //  1. full Newton steps (KIN_NONE). The Newton step does not depend on how rows are scaled, but a
@@ -42,6 +43,11 @@ struct KinsolData {
   int since_halved = 0;
   double best_norm = INFINITY;  // lowest max-norm seen, and where
   Eigen::VectorXd best_x;
+  // An affine F's full steps evaluate no Jacobian after the first: each iterate's residual norm
+  // is recorded when the next iterate is evaluated (as a Jacobian there would record it).
+  bool record_at_residuals = false;
+  int residuals = 0;  // evaluations in this KINSOL run
+  double pending = NAN;
 };
 
 Eigen::Map<Eigen::VectorXd> view(N_Vector v) {
@@ -69,6 +75,13 @@ int kin_residual(N_Vector u, N_Vector f, void* user) {
       }
     }
     if (!ok) return 1;  // recoverable: the line search shortens the step
+    if (d->record_at_residuals && d->residuals++ > 0) {  // the first is F at the start, recorded before
+      if (!std::isnan(d->pending)) {
+        d->history->push_back(d->pending);
+        if (d->options->on_iteration) d->options->on_iteration(++d->jacobians, d->pending);
+      }
+      d->pending = norm;
+    }
     if (norm < d->best_norm) {
       d->best_norm = norm;
       d->best_x = d->x;
@@ -112,6 +125,7 @@ int kin_jacobian(N_Vector u, N_Vector, SUNMatrix Jm, void* user, N_Vector, N_Vec
     copy_to_sundials(d->J, Jm, d->LS);
     // KINSOL evaluates F at u before the Jacobian there: d->F is F(u).
     const double norm = d->F.lpNorm<Eigen::Infinity>();
+    if (d->record_at_residuals && d->jacobians > 0) return 0;  // recorded at the residuals (a refresh)
     if (++d->jacobians > 1) d->history->push_back(norm);  // the start is recorded before KINSol
     if (d->options->on_iteration) d->options->on_iteration(d->jacobians, norm);
     return 0;
@@ -162,7 +176,13 @@ int kinsol_run(KinsolData& data, Eigen::VectorXd& x, const SolverOptions& opt, i
   KINSetUserData(k.mem, &data);
   KINSetLinearSolver(k.mem, k.LS, k.J);
   KINSetJacFn(k.mem, kin_jacobian);
-  KINSetMaxSetupCalls(k.mem, 1);  // exact Newton: fresh Jacobian each iteration
+  // Exact Newton: a fresh Jacobian each iteration, or for an affine F's full steps the first one
+  // throughout (KINSOL still refreshes it if a linear solve fails).
+  const bool affine_steps = opt.affine && strategy == KIN_NONE;
+  KINSetMaxSetupCalls(k.mem, affine_steps ? opt.max_iterations + 1 : 1);
+  data.record_at_residuals = affine_steps;
+  data.residuals = 0;
+  data.pending = NAN;
   KINSetFuncNormTol(k.mem, opt.tolerance);
   KINSetScaledStepTol(k.mem, 1e-15);
   KINSetNumMaxIters(k.mem, std::max(1, opt.max_iterations - iterations));

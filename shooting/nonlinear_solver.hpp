@@ -1,5 +1,6 @@
 // A square nonlinear system F(x) = 0 with an exact Jacobian, and the solver backends behind one
-// interface: SUNDIALS KINSOL (Newton with line search, fresh Jacobian every iteration) and NLopt
+// interface: SUNDIALS KINSOL (Newton with line search, fresh Jacobian every iteration unless F is
+// affine) and NLopt
 // (SLSQP with the equations as equality constraints). The C libraries stay in the .cpp files.
 // Jacobians are sparse (a shooting Jacobian is block bidiagonal): KINSOL factors them with
 // KLU, so that memory and work grow like the number of segments, not its square or cube.
@@ -41,6 +42,10 @@ struct SolverOptions {
   // Called at each Jacobian evaluation (one per iteration) with the iteration number (1, 2, ...)
   // and the max-norm of F there: for progress displays. Must not throw.
   std::function<void(int, double)> on_iteration;
+  // F is affine in x (its Jacobian is the same everywhere: a problem without a group whose
+  // Lagrangian is quadratic and constraints linear, core/degree.hpp). KINSOL then factors the
+  // Jacobian once, and its later full Newton steps, on that factorization, are exact Newton steps.
+  bool affine = false;
 };
 
 enum class SolverStatus { Converged, NotConverged, Failed };

@@ -54,6 +54,12 @@ struct GalerkinScheme {
     return out;
   }
   static Flow flow(const BVP& bvp, const NewtonOptions& step) { return Flow(bvp.model, bvp.h(), step); }
+  // Without a group, with a quadratic ℓ and linear constraints (core/degree.hpp), the shooting
+  // conditions are affine: the flows' end states are affine in their starts, the fixed and natural
+  // boundary rows are affine in the end intervals, and tangent coordinates are differences.
+  static bool affine(const BVP& bvp, const NewtonOptions& step) {
+    return Sch::d == 0 && step.reuse_constant_matrix && model_is_quadratic(bvp.model);
+  }
   static Run run(const Flow& flow, const State& start, int index, int steps, const Eigen::MatrixXd* seed) {
     return flow.run(start.iv, steps, seed, start.g, index);
   }

@@ -216,6 +216,8 @@ struct NodalScheme {
     return out;
   }
   static Flow flow(const BVP& bvp, const NewtonOptions& step) { return Flow(bvp.problem, bvp.h(), step); }
+  // The closures' rows are not probed for linearity: every iteration evaluates its Jacobian.
+  static bool affine(const BVP&, const NewtonOptions&) { return false; }
   static Run run(const Flow& flow, const State& start, int /*index*/, int steps, const Eigen::MatrixXd* seed) {
     return flow.run(start.s, steps + 2 * k - 1, seed, start.g);
   }

@@ -121,6 +121,7 @@ ShootingResult<X> solve_from_starts(const typename SchemeFor<X>::BVP& bvp,
   system.set_row_scaling(system.row_tolerances(x, opt.solver.tolerance).cwiseInverse());
   SolverOptions scaled = opt.solver;
   scaled.tolerance = 1.0;
+  scaled.affine = A::affine(bvp, opt.step);
   const SolverOutcome so = solve_nonlinear(system, x, scaled);
   out.iterations = so.iterations;
   out.residual_history = so.residual_history;

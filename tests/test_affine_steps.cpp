@@ -2,9 +2,12 @@
 // the others, and their flows, which factor one step matrix for the whole flow and reuse the
 // step's sensitivity, give the same trajectory and sensitivities as flows that evaluate and
 // factor the exact matrix at every step (paper scheme and Galerkin), the sensitivities also
-// against central differences, which are exact up to rounding for an affine flow.
+// against central differences, which are exact up to rounding for an affine flow; and a shooting
+// solve, where KINSOL keeps the first Jacobian's factorization, equals one with a Jacobian per
+// iteration.
 #include <lpshoot/problems/beanie.hpp>
 #include <lpshoot/problems/electron_bvp.hpp>
+#include <lpshoot/problems/electron_exact.hpp>
 
 #include <gtest/gtest.h>
 
@@ -223,4 +226,38 @@ TEST(AffineFlows, PaperElectronEqualsNewtonAtEveryStep) {
               relative_difference(b.sensitivity, a.sensitivity));
   EXPECT_LT(states, 1e-14 * N * amplification);
   EXPECT_LT(relative_difference(b.sensitivity, a.sensitivity), 1e-15 * N);
+}
+
+TEST(AffineShooting, ElectronSolveEqualsOneWithAJacobianPerIteration) {
+  // Galerkin 4, multiple shooting (segments auto: 20 of 100 steps). Affine: flows on one step
+  // matrix, KINSOL on the first Jacobian. The other: everything evaluated afresh.
+  const Electron e{};
+  const ElectronBoundary a{Eigen::Vector3d(1.0, 0.0, 0.5), Eigen::Vector3d(0.0, 1.0, 0.0)};
+  const ElectronBoundary z{Eigen::Vector3d(0.0, 1.0, -0.5), Eigen::Vector3d(-1.0, 0.0, 0.2)};
+  const double T = 2.0;
+  const int N = 2000;
+  const auto bvp = electron_galerkin_bvp<3>(model_of(e), T, N, a, z);
+  const auto exact = electron_exact_optimum(e, T, a.position, a.velocity, z.position, z.velocity);
+  ShootingOptions affine, fresh;
+  affine.method = fresh.method = ShootingMethod::Multiple;
+  affine.solver.tolerance = fresh.solver.tolerance = 1e-12;
+  fresh.step.reuse_constant_matrix = false;
+  const auto ra = solve_bvp(bvp, electron_galerkin_guess<3>(bvp, a, z), affine);
+  const auto rf = solve_bvp(bvp, electron_galerkin_guess<3>(bvp, a, z), fresh);
+  ASSERT_TRUE(ra.ok()) << ra.message;
+  ASSERT_TRUE(rf.ok()) << rf.message;
+  EXPECT_EQ(ra.iterations, rf.iterations);
+  EXPECT_EQ(ra.residual_history.size(), rf.residual_history.size());
+  EXPECT_EQ(ra.rank, ra.unknowns);
+  double between = 0, err = 0;
+  for (int n = 0; n <= N; ++n) {
+    between = std::max(between, (ra.trajectory.x(n) - rf.trajectory.x(n)).lpNorm<Eigen::Infinity>());
+    err = std::max(err, (ra.trajectory.x(n) - exact.position(n * bvp.h())).lpNorm<Eigen::Infinity>());
+  }
+  std::printf("N = %d, %d iterations: affine vs fresh %.1e, error against the exact optimum %.1e (h^4 = %.1e)\n", N,
+              ra.iterations, between, err, std::pow(bvp.h(), 4));
+  // Both are solved to the tolerance; what differs is rounding (~1e-13 here).
+  EXPECT_LT(between, 1e-11);
+  EXPECT_LT(std::abs(ra.cost - rf.cost), 1e-12 * std::abs(rf.cost));
+  EXPECT_LT(err, 1e-9);  // truncation ~h^4 = 1e-12 times the solution's derivatives
 }

@@ -197,6 +197,27 @@ TEST(StructuredDiagnosis, DependentRowsAreFoundAndNamedAsByTheDenseSVD) {
   EXPECT_GT(sparse.singular_values[J.cols() - 2], 1e-4 * sparse.singular_values.front());
 }
 
+TEST(StructuredDiagnosis, NearlyDependentRowsAgreeWithDenseOnBothSidesOfTheTolerance) {
+  // The last row moved off a combination of three others by delta e_3: the smallest singular
+  // value is ~delta. Below the tolerance (1e-10) both diagnoses find one dependent condition;
+  // above it both find full rank: at 1e-8 the sparse QR runs (the condition allows a
+  // deficiency) and finds none, at 1e-2 the condition estimate alone shows full rank.
+  for (double delta : {1e-12, 1e-8, 1e-2}) {
+    Eigen::MatrixXd J = block_bidiagonal(12, 6, 2, 11);
+    const int last = static_cast<int>(J.rows()) - 1;
+    J.row(last) = 0.5 * J.row(1) + J.row(10) - J.row(40);
+    J(last, 3) += delta;
+    const auto names = row_names(J.rows());
+    const RankDiagnosis sparse = diagnose_rank(SparseJacobian(J.sparseView()), names, 1e-10);
+    const RankDiagnosis dense = diagnose_rank(J, names, 1e-10);
+    std::printf("delta %.0e: rank structured %d, dense %d, condition %.2e\n", delta, sparse.rank, dense.rank,
+                sparse.condition);
+    EXPECT_EQ(sparse.rank, dense.rank) << delta;
+    EXPECT_EQ(sparse.rank, delta < 1e-10 ? last : last + 1) << delta;
+    EXPECT_EQ(sparse.dependent_conditions.size(), delta < 1e-10 ? 1u : 0u) << delta;
+  }
+}
+
 TEST(StructuredDiagnosis, NonFiniteEntriesHaveNoRank) {
   Eigen::MatrixXd J = block_bidiagonal(3, 4, 2, 5);
   J(3, 2) = NAN;
