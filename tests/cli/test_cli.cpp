@@ -345,7 +345,9 @@ TEST(Sweep, GalerkinSchemesReachOrdersFourAndSixAgainstTheExactOptimum) {
     const double expected = i / 3 == 0 ? 2.0 : i / 3 == 1 ? 4.0 : 6.0;
     EXPECT_NEAR(r["order"].get<double>(), expected, 0.2) << r.dump();
     const double cost_order = std::log2(sw["runs"][i - 1]["cost_error"].get<double>() / r["cost_error"].get<double>());
-    if (i / 3 > 0) EXPECT_NEAR(cost_order, expected, 0.2) << r.dump();
+    if (i / 3 > 0) {
+      EXPECT_NEAR(cost_order, expected, 0.2) << r.dump();
+    }
   }
   EXPECT_LT(sw["runs"][8]["error"].get<double>(), 1e-12);
   EXPECT_EQ(slurp(work / "out" / "sweep.csv").rfind("N,h,scheme,method,backend,", 0), 0u);

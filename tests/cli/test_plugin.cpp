@@ -200,7 +200,9 @@ TEST_P(BadPlugins, FailCleanlyNamingTheFile) {
   EXPECT_NE(o.err.find(c.name + ".cpp"), std::string::npos) << o.err;
   EXPECT_NE(o.err.find(c.expected), std::string::npos) << o.err;
   EXPECT_FALSE(fs::exists(work / "out"));
-  if (c.leaves_nothing) EXPECT_TRUE(cache_is_empty(work / "cache"));
+  if (c.leaves_nothing) {
+    EXPECT_TRUE(cache_is_empty(work / "cache"));
+  }
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(work / "cache", ec))
     EXPECT_EQ(entry.path().string().find(".building-"), std::string::npos) << entry.path();
