@@ -6,6 +6,7 @@ set -euo pipefail
 packages=(
   g++ cmake make ccache pkg-config
   libeigen3-dev                      # Eigen 3.4
+  liblapack-dev                      # dgbsv, for the banded floor in bench/bench_floor.cpp
   libsundials-dev                    # SUNDIALS 6.4 (KINSOL)
   libnlopt-dev libnlopt-cxx-dev      # NLopt 2.7
   libboost-dev                       # Boost 1.74 (Odeint; SHA-1 for the plugin cache)
