@@ -184,6 +184,9 @@ struct GalerkinScheme {
     Trajectory& tr = out.trajectory;
     tr.h = bvp.h();
     tr.g0 = first.g;
+    size_t total = 1;
+    for (const auto& run : runs) total += run.trajectory.intervals.size() - 1;
+    tr.intervals.reserve(total);  // one allocation (N up to 1e6: ~100 MB)
     tr.intervals = runs[0].trajectory.intervals;
     for (size_t i = 1; i < runs.size(); ++i) {
       const auto& t = runs[i].trajectory.intervals;

@@ -130,11 +130,14 @@ class ShootingSystem : public NonlinearSystem {
   // The conditions in their own units (no row scaling).
   bool raw_residual(const Eigen::VectorXd& x, Eigen::VectorXd& F) { return evaluate(x, F, nullptr); }
 
-  // The segment runs at x: those of the last evaluation when it was at x, else propagated anew.
+  // The segment runs at x: those of the last evaluation when it was at x (moved out of the
+  // memo, which keeps its residual and Jacobian), else propagated anew.
   bool runs_at(const Eigen::VectorXd& x, std::vector<typename A::Run>& runs, std::vector<State>& starts) {
     if (memo_ok_ && memo_x_.size() == x.size() && memo_x_ == x && !memo_runs_.empty()) {
-      runs = memo_runs_;
-      starts = memo_starts_;
+      runs = std::move(memo_runs_);
+      starts = std::move(memo_starts_);
+      memo_runs_.clear();
+      memo_starts_.clear();
       return true;
     }
     std::vector<Eigen::MatrixXd> Jr;
