@@ -91,10 +91,11 @@ class GalerkinFlow {
     Interval<Sch, double> s = start;
     // With sensitivities, each step's exact matrix at its solution, factored: the next step's
     // Newton iterates with it first (newton_solve). Without, every step evaluates its own.
-    // Affine steps (no group, degree.hpp) need one evaluation each after the first: the step map
-    // is affine and the same at every step (ℓ does not depend on time), unknowns = z_c + dz ·
-    // state, with dz the step sensitivity and z_c read off the first step, solved by Newton; one
-    // correction by the first step's factored matrix removes the map's rounding (affine_step).
+    // Affine steps (no group, degree.hpp) after the first start from the step map's prediction
+    // z_c + dz · state (dz the step sensitivity, z_c read off the first step, solved by Newton;
+    // the map is the same at every step, ℓ not depending on time) and take one correction with
+    // the first step's factored matrix: one evaluation per step. The correction is needed: the
+    // map alone is off by δ(dz) |state - state_0|, δ(dz) ~ cond(J) u |dz|.
     ChordMatrix<nz> chord;
     ChordMatrix<nz>* const chord_used = seed ? &chord : nullptr;
     StepCarry<Sch> carry;  // interval derivatives shared by consecutive steps
@@ -103,17 +104,15 @@ class GalerkinFlow {
     double condition = 0;  // dz's step matrix's
     bool dz_current = false;
     Vec<double, nz> z_c;
-    bool mapped = false;  // z_c is known: later steps apply the affine map
+    bool mapped = false;  // z_c is known: later steps start from the affine map
     for (int k = 1; k <= steps; ++k) {
       Interval<Sch, double> z;
-      bool solved = false;
+      Vec<double, nz> predicted;
       if constexpr (d == 0) {
-        if (mapped) {
-          if (!rep.add(affine_step(s, dz, z_c, chord, first_node + k, z))) return out;
-          solved = true;
-        }
+        if (mapped) predicted = z_c + dz * flat_coordinates(s);
       }
-      if (!solved && !rep.add(solve_galerkin_step<Sch>(model_, h_, s, first_node + k, options_, z, chord_used, carry_used)))
+      if (!rep.add(solve_galerkin_step<Sch>(model_, h_, s, first_node + k, options_, z, mapped ? &chord : chord_used,
+                                            carry_used, mapped ? &predicted : nullptr, mapped)))
         return out;
       if (seed || affine_) {
         if (!dz_current) {
@@ -164,49 +163,16 @@ class GalerkinFlow {
   }
 
  private:
-  static constexpr int nz_ = Sch::unknowns, ns_ = Sch::state;
-
   // An interval's tangent coordinates without a group: (x, v, X2, V1, local variables).
-  static Vec<double, ns_> flat_coordinates(const Interval<Sch, double>& iv) {
+  static Vec<double, Sch::state> flat_coordinates(const Interval<Sch, double>& iv) {
     static_assert(Sch::d == 0, "plain coordinates only without a group");
-    Vec<double, ns_> c;
+    Vec<double, Sch::state> c;
     c.template segment<Sch::r>(Sch::x_off) = iv.x;
     c.template segment<Sch::r>(Sch::v_off) = iv.v;
     c.template segment<Sch::r>(Sch::X2_off) = iv.X2;
     c.template segment<Sch::r>(Sch::V1_off) = iv.V1;
     c.template segment<Sch::aux>(Sch::aux_off) = iv.w;
     return c;
-  }
-
-  // Step n of an affine flow (see run): the map's unknowns z_c + dz · state, corrected once by
-  // the factored step matrix, F(z) = F(z_map) + J (z - z_map) being exact. The map alone is
-  // accurate only to |δ(dz)| |state - state_0| (cond(J) u relative to the state's excursion since
-  // z_c was read off); the correction, relative to F(z_map), brings z to roundoff as Newton's.
-  StepReport affine_step(const Interval<Sch, double>& s, const Eigen::Matrix<double, nz_, ns_>& dz,
-                         const Vec<double, nz_>& z_c, const ChordMatrix<nz_>& J, int n, Interval<Sch, double>& z) const {
-    constexpr int r = Sch::r, nv = Sch::variation;
-    StepReport sr;
-    sr.step = n;
-    sr.condition = J.condition;
-    sr.iterations = 1;
-    const Vec<double, nz_> u = z_c + dz * flat_coordinates(s);
-    const Vec<double, nv> fixed = node_residual<Sch, double>(model_, &s, nullptr, h_);
-    z = s;
-    const Interval<Sch, double> base = next_interval_base(s, h_);
-    z.x = base.x, z.v = base.v;
-    z.X2 = u.template segment<r>(0);
-    z.V1 = u.template segment<r>(r);
-    z.w = u.template tail<Sch::aux>();
-    const Vec<double, nz_> F = galerkin_step_residual<Sch>(model_, h_, s, z, fixed);
-    if (!F.allFinite()) {
-      sr.status = StepStatus::NonFinite;
-      sr.message = "step n=" + std::to_string(n) + ": the step equations evaluated to a non-finite number";
-      return sr;
-    }
-    sr.residual = F.template lpNorm<Eigen::Infinity>();
-    apply_galerkin_correction<Sch>(z, J.lu.solve(-F), h_);
-    sr.status = StepStatus::Converged;
-    return sr;
   }
 
   Model model_;

@@ -242,18 +242,29 @@ void apply_galerkin_correction(Interval<Sch, double>& z, const Vec<double, Sch::
 }
 
 // Solves step n (interval n from interval n-1 = `state`) by Newton from the predictor "interval
-// n-1's unknowns"; on return z is interval n (its base node included).
+// n-1's unknowns", or `predictor` (unknowns' layout; without a group); on return z is interval n
+// (its base node included).
 // `chord`: a flow's factored step matrix, for chord iterations (newton_solve).
 // `carry`: the state's derivatives, when the flow has them (its part of E_n is read off them).
+// `affine`: the step equations are affine and `chord` is their matrix (newton_solve).
 template <class Sch>
 StepReport solve_galerkin_step(const typename Sch::Model& model, double h, const Interval<Sch, double>& state, int n,
                                const NewtonOptions& opt, Interval<Sch, double>& z,
-                               ChordMatrix<Sch::unknowns>* chord = nullptr,
-                               const StepCarry<Sch>* carry = nullptr) {
+                               ChordMatrix<Sch::unknowns>* chord = nullptr, const StepCarry<Sch>* carry = nullptr,
+                               const Vec<double, Sch::unknowns>* predictor = nullptr, bool affine = false) {
   constexpr int r = Sch::r, d = Sch::d, nz = Sch::unknowns, nv = Sch::variation;
   z = state;
   const Interval<Sch, double> base = next_interval_base(state, h);
   z.x = base.x, z.v = base.v, z.Om = base.Om;
+  if constexpr (d == 0) {  // with a group the predictor is interval n-1's unknowns
+    if (predictor) {
+      z.X2 = predictor->template segment<r>(0);
+      z.V1 = predictor->template segment<r>(r);
+      z.w = predictor->template tail<Sch::aux>();
+    }
+  } else {
+    (void)predictor;
+  }
   Vec<double, nv> fixed;
   if constexpr (Sch::d == 0) {
     if (carry && carry->valid)
@@ -286,7 +297,7 @@ StepReport solve_galerkin_step(const typename Sch::Model& model, double h, const
         scale.template tail<Sch::aux>() = z.w.cwiseAbs();
         return scale;
       },
-      chord);
+      chord, affine);
 }
 
 // dz/d(state) at a solved step (nz x ns), by the implicit function theorem. Optionally the step

@@ -150,9 +150,11 @@ Eigen::Matrix<double, nz, ns> implicit_sensitivity(const Eigen::Matrix<double, n
 // first iterations are chord steps with it, and the exact Jacobian is evaluated only when they
 // stop contracting by 4x (the Jacobian reuse of implicit integrators; the converged z is the
 // same, to the step tolerance). A Jacobian evaluated here is left in `chord` for the next step.
+// `affine`: the equations are affine and the matrix (chord or evaluated) is theirs, so the first
+// correction solves them to rounding and no confirming evaluation is made.
 template <int n, class Jacobian, class Residual, class Correct, class Magnitude>
 StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian, Residual&& residual, Correct&& correct,
-                        Magnitude&& magnitude, ChordMatrix<n>* chord = nullptr) {
+                        Magnitude&& magnitude, ChordMatrix<n>* chord = nullptr, bool affine = false) {
   StepReport rep;
   rep.step = step;
   auto fail = [&](StepStatus st, const std::string& why) {
@@ -190,7 +192,7 @@ StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian,
     const Vn dz = lu.solve(-F);
     const Vn scale = magnitude();
     correct(dz);
-    if (((dz.cwiseAbs().array() - opt.step_tolerance * (1.0 + scale.array())) <= 0.0).all()) {
+    if (affine || ((dz.cwiseAbs().array() - opt.step_tolerance * (1.0 + scale.array())) <= 0.0).all()) {
       rep.status = StepStatus::Converged;
       return rep;
     }
