@@ -2,6 +2,8 @@
 // dense and sparse factorizations cost ~40 s of compilation in every file that would include them.
 #include "diagnostics.hpp"
 
+#include "band_lu.hpp"
+
 #include <Eigen/LU>
 #include <Eigen/QR>
 #include <Eigen/OrderingMethods>
@@ -72,16 +74,16 @@ RankDiagnosis diagnose_rank(Eigen::MatrixXd J, const std::vector<std::string>& n
 namespace {
 // Hager's estimate of |A^{-1}|_1 (Higham, Algorithm 14.1) from a factorization's solves with A
 // and A^T: a lower bound, exact or within a small factor in practice (as LAPACK's dgecon).
-template <class LU>
-double inverse_one_norm_estimate(LU& lu, int n) {  // non-const: Eigen's transpose() view
+template <class Solve, class SolveTransposed>
+double inverse_one_norm_estimate(const Solve& solve, const SolveTransposed& solve_transposed, int n) {
   Eigen::VectorXd x = Eigen::VectorXd::Constant(n, 1.0 / n), y;
   double estimate = 0;
   int last = -1;
   for (int iteration = 0; iteration < 5; ++iteration) {
-    y = lu.solve(x);
+    y = solve(x);
     estimate = y.lpNorm<1>();
     const Eigen::VectorXd xi = y.unaryExpr([](double v) { return v >= 0 ? 1.0 : -1.0; });
-    const Eigen::VectorXd z = lu.transpose().solve(xi);
+    const Eigen::VectorXd z = solve_transposed(xi);
     int j = 0;
     const double zmax = z.cwiseAbs().maxCoeff(&j);
     if (zmax <= z.dot(x) || j == last) break;
@@ -127,17 +129,26 @@ RankDiagnosis diagnose_rank(Eigen::SparseMatrix<double, Eigen::ColMajor, int> J,
     }
   J.prune(0.0);
   const int n = static_cast<int>(J.cols());
-  Eigen::SparseLU<Sparse, Eigen::COLAMDOrdering<int>> lu;
-  lu.compute(J);
   double norm1 = 0;
   for (int c = 0; c < n; ++c) norm1 = std::max(norm1, J.col(c).cwiseAbs().sum());
   out.condition = INFINITY;
   double inverse_norm1 = INFINITY;
-  if (lu.info() == Eigen::Success) {
-    inverse_norm1 = inverse_one_norm_estimate(lu, n);
-    const double c = norm1 * inverse_norm1;
-    if (std::isfinite(c)) out.condition = c;
+  // A banded J (the shooting Jacobian: block bidiagonal with boundary rows) is factored in band
+  // storage (band_lu.hpp: 4x faster than Eigen's SparseLU at N = 1e5); a wider pattern by sparse LU.
+  const auto [kl, ku] = BandLU::bandwidths(J);
+  if (static_cast<double>(2 * kl + ku + 1) * n <= 4.0 * static_cast<double>(J.nonZeros()) + n) {
+    const BandLU lu(J, kl, ku);
+    if (lu.ok())
+      inverse_norm1 = inverse_one_norm_estimate([&](const Eigen::VectorXd& b) { return lu.solve(b); },
+                                                [&](const Eigen::VectorXd& b) { return lu.solve_transposed(b); }, n);
+  } else {
+    Eigen::SparseLU<Sparse, Eigen::COLAMDOrdering<int>> lu;
+    lu.compute(J);
+    if (lu.info() == Eigen::Success)
+      inverse_norm1 = inverse_one_norm_estimate([&](const Eigen::VectorXd& b) -> Eigen::VectorXd { return lu.solve(b); },
+                                                [&](const Eigen::VectorXd& b) -> Eigen::VectorXd { return lu.transpose().solve(b); }, n);
   }
+  if (std::isfinite(norm1 * inverse_norm1)) out.condition = norm1 * inverse_norm1;
   // The QR runs only when it can find a deficiency: its test (a column's norm, orthogonalized
   // against the columns before it, below `tolerance`) cannot fire when σ_min(J) > tolerance, and
   // σ_min(J) >= 1 / (√n |J⁻¹|₁). Hager's estimate of |J⁻¹|₁ is a lower bound, within a small

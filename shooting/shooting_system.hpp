@@ -47,6 +47,31 @@ using SchemeFor = typename SchemeOf<X>::type;
 
 namespace detail {
 
+// A square matrix whose column block i (n columns from i n) is the dense [top_i; bottom_i] from
+// row first_row_i, written straight into compressed column storage (no triplets, no sort).
+template <int n>
+void write_block_columns(SparseJacobian& J, int N, const std::vector<int>& first_row,
+                         const std::vector<Eigen::MatrixXd>& top, const std::vector<Eigen::MatrixXd>& bottom) {
+  const int S = static_cast<int>(first_row.size());
+  Eigen::Index nnz = 0;
+  for (int i = 0; i < S; ++i) nnz += (top[i].rows() + bottom[i].rows()) * n;
+  J.resize(N, N);  // compressed, no entries
+  J.resizeNonZeros(nnz);
+  int* outer = J.outerIndexPtr();
+  int* inner = J.innerIndexPtr();
+  double* value = J.valuePtr();
+  int k = 0;
+  for (int i = 0; i < S; ++i) {
+    const int t = static_cast<int>(top[i].rows()), b = static_cast<int>(bottom[i].rows());
+    for (int c = 0; c < n; ++c) {
+      outer[i * n + c] = k;
+      for (int r = 0; r < t; ++r, ++k) inner[k] = first_row[i] + r, value[k] = top[i](r, c);
+      for (int r = 0; r < b; ++r, ++k) inner[k] = first_row[i] + t + r, value[k] = bottom[i](r, c);
+    }
+  }
+  outer[N] = k;
+}
+
 // The shooting equations for S >= 1 segments between state indices s_0 < s_1 < ... < s_S
 // (s_0 = A::first_state, s_S = A::last_state).
 template <class X>
@@ -105,17 +130,16 @@ class ShootingSystem : public NonlinearSystem {
     if (!ok) return t;
     Eigen::VectorXd mag(size());
     for (int i = 0; i < S; ++i) mag.segment(i * n, n) = A::magnitudes(bvp_, refs_[i]);
-    // J_δ = J_x diag(M, ..., M): each segment's block of columns times M.
-    std::vector<Eigen::Triplet<double, int>> blocks;
-    blocks.reserve(static_cast<size_t>(S) * n * n);
-    for (int i = 0; i < S; ++i)
-      for (int c = 0; c < n; ++c)
-        for (int r = 0; r < n; ++r) blocks.emplace_back(i * n + r, i * n + c, M_(r, c));
-    SparseJacobian Mb(size(), size());
-    Mb.setFromTriplets(blocks.begin(), blocks.end());
-    const SparseJacobian Jd = J * Mb;
+    // |J_δ| |state| with J_δ = J_x diag(M, ..., M), block column by block column (the layout of
+    // write_block_columns: column block i is one dense block of rows).
     constexpr double u = std::numeric_limits<double>::epsilon();
-    const Eigen::ArrayXd floor = A::roundoff_factor * u * (Jd.cwiseAbs() * mag).array();
+    Eigen::ArrayXd floor = Eigen::ArrayXd::Zero(size());
+    for (int i = 0; i < S; ++i) {
+      const int first = J.outerIndexPtr()[i * n], rows = J.outerIndexPtr()[i * n + 1] - first;
+      const Eigen::Map<const Eigen::MatrixXd> B(J.valuePtr() + first, rows, n);
+      floor.segment(J.innerIndexPtr()[first], rows) += ((B * M_).cwiseAbs() * mag.segment(i * n, n)).array();
+    }
+    floor *= A::roundoff_factor * u;
     t.array() += floor.min(1e4 * tol);  // at most four digits conceded to roundoff: beyond, not converged
     floor_ratio_ = floor.maxCoeff() / tol;
     // A continuity row of two states cannot be known better than their rounding, u |M| |state|,
@@ -261,20 +285,18 @@ class ShootingSystem : public NonlinearSystem {
     }
     const int S = segments(), N = size();
     F.resize(N);
-    // The Jacobian's n x n blocks, every entry stored (zeros too): its pattern stays the same
-    // from one evaluation to the next, so the sparse factorization's analysis is reused.
-    std::vector<Eigen::Triplet<double, int>> entries;
-    if (J) entries.reserve(static_cast<size_t>(2 * S + 1) * n * n);
-    auto put = [&](int row, int col, const Eigen::MatrixXd& B) {
-      for (int c = 0; c < B.cols(); ++c)
-        for (int r = 0; r < B.rows(); ++r) entries.emplace_back(row + r, col + c, B(r, c));
-    };
+    // Column block i (segment i's unknowns) is nonzero in one range of rows: the conditions on
+    // segment i's start (the initial rows, or continuity i-1) then those on its end (continuity
+    // i, or the terminal rows). Each part is a dense block, zeros stored too: the pattern is the
+    // same at every evaluation (the sparse factorization's analysis is reused).
+    std::vector<Eigen::MatrixXd> top(J ? S : 0), bottom(J ? S : 0);
+    std::vector<int> first_row(J ? S : 0);
     int row = 0;
     Eigen::VectorXd R;
     Eigen::MatrixXd JB;
     A::boundary_block(bvp_, End::Initial, starts[0], R, J ? &JB : nullptr);
     F.segment(row, R.size()) = R;
-    if (J) put(row, 0, JB * Jr[0]);
+    if (J) top[0] = JB * Jr[0];
     row += R.size();
     for (int i = 0; i + 1 < S; ++i) {  // continuity: end of segment i minus start of segment i+1
       const State e = A::end_state(runs[i]);
@@ -282,21 +304,18 @@ class ShootingSystem : public NonlinearSystem {
       if (J) {
         Eigen::MatrixXd De, Ds;
         A::difference_jacobians(bvp_, e, starts[i + 1], De, Ds);
-        put(row, i * n, M_ * De * runs[i].sensitivity);
-        put(row, (i + 1) * n, M_ * Ds * Jr[i + 1]);
+        bottom[i] = M_ * De * runs[i].sensitivity;
+        top[i + 1] = M_ * Ds * Jr[i + 1];
+        first_row[i + 1] = row;
       }
       row += n;
     }
     const State e = A::end_state(runs[S - 1]);
     A::boundary_block(bvp_, End::Terminal, e, R, J ? &JB : nullptr);
     F.segment(row, R.size()) = R;
-    if (J) put(row, (S - 1) * n, JB * runs[S - 1].sensitivity);
+    if (J) bottom[S - 1] = JB * runs[S - 1].sensitivity;
     row += R.size();
-    if (J) {
-      J->resize(N, N);
-      J->setFromTriplets(entries.begin(), entries.end());
-      J->makeCompressed();
-    }
+    if (J && row == N) write_block_columns<n>(*J, N, first_row, top, bottom);
     return row == N;
   }
 
