@@ -6,6 +6,8 @@
 #include <lpshoot/problems/beanie_bvp.hpp>
 #include <lpshoot/problems/electron_bvp.hpp>
 
+#include "oracles/galerkin_electron.hpp"
+
 #include <benchmark/benchmark.h>
 
 using namespace lpshoot;
@@ -87,6 +89,56 @@ static void BM_ElectronGalerkinStep(benchmark::State& st) {
 }
 BENCHMARK_TEMPLATE(BM_ElectronGalerkinStep, 3)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 BENCHMARK_TEMPLATE(BM_ElectronGalerkinStep, 4)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+// The hand-written electron Galerkin 4 step (tests/oracles/galerkin_electron.cpp: M, K and R
+// formed and K factored at every call), /0 the step, /1 with its sensitivity: the baseline of
+// BM_ElectronGalerkinStep<3>.
+static void BM_ElectronHandGalerkinStep(benchmark::State& st) {
+  const ElectronModel m = model_of(Electron{});
+  const auto iv = electron_start<3>(m);
+  oracles::GalerkinElectronState c;
+  c << iv.x, iv.v, iv.X2, iv.V1;
+  oracles::GalerkinElectronMap Phi;
+  for (auto _ : st) {
+    auto z = oracles::electron_galerkin4_step(m, kH, c, st.range(0) != 0 ? &Phi : nullptr);
+    benchmark::DoNotOptimize(z.data());
+    benchmark::DoNotOptimize(Phi.data());
+  }
+}
+BENCHMARK(BM_ElectronHandGalerkinStep)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+// A 200-step hand flow (the step map formed once, as the engine's affine flow does), /1 carrying
+// the 12 x 12 sensitivity: the baseline of BM_ElectronGalerkinFlow<3>.
+static void BM_ElectronHandGalerkinFlow(benchmark::State& st) {
+  constexpr int steps = 200;
+  const ElectronModel m = model_of(Electron{});
+  const auto iv = electron_start<3>(m);
+  oracles::GalerkinElectronState c0;
+  c0 << iv.x, iv.v, iv.X2, iv.V1;
+  const bool sensitivity = st.range(0) != 0;
+  for (auto _ : st) {
+    const oracles::GalerkinElectronMap Phi = oracles::electron_galerkin4_step_map(m, kH);
+    oracles::GalerkinElectronState c = c0, cn;
+    Eigen::Matrix<double, 12, 12> S = Eigen::Matrix<double, 12, 12>::Identity(), next;
+    for (int k = 0; k < steps; ++k) {  // interval n: base node = end of interval n-1, increments Φ c
+      cn.head<3>() = c.head<3>() + kH * c.segment<3>(3) + (kH * kH) * c.segment<3>(6);
+      cn.segment<3>(3) = c.segment<3>(3) + kH * c.tail<3>();
+      cn.tail<6>().noalias() = Phi * c;
+      c.swap(cn);
+      if (sensitivity) {
+        next.topRows<3>() = S.topRows<3>() + kH * S.middleRows<3>(3) + (kH * kH) * S.middleRows<3>(6);
+        next.middleRows<3>(3) = S.middleRows<3>(3) + kH * S.bottomRows<3>();
+        next.bottomRows<6>().noalias() = Phi.lazyProduct(S);
+        S.swap(next);
+      }
+    }
+    benchmark::DoNotOptimize(c.data());
+    benchmark::DoNotOptimize(S.data());
+  }
+  st.counters["per_step"] = benchmark::Counter(static_cast<double>(steps) * st.iterations(),
+                                               benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_ElectronHandGalerkinFlow)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 // The step's equations with the state's columns (what each sensitivity costs), electron: /0
 // nested duals through the jet and ℓ (evaluate_galerkin_step_nested), /1 the chain rule through

@@ -34,6 +34,76 @@ struct FlatIntervalDerivatives {
   Eigen::Matrix<double, ne, ne> hessian;     // [[∇²_y L~, ∂C/∂y], [∂C/∂yᵀ, 0]]
 };
 
+// K_i of the file comment (3 x (4 + S - 3), scalar columns x, v, X2, V1, bubbles) at Gauss
+// point i, and the jet q_i = (K_i ⊗ I_r) y (block by block: K's zeros are skipped).
+template <class Sch>
+struct FlatJetMap {
+  static constexpr int r = Sch::r, cols = 4 + Sch::bubbles;
+  Eigen::Matrix<double, 3, cols> K = Eigen::Matrix<double, 3, cols>::Zero();
+
+  FlatJetMap(double h, int i) {
+    const auto& tab = GalerkinTable<Sch::degree, Sch::gauss>::get();
+    const auto& B = tab.basis[i];
+    K(0, 0) = 1, K(0, 1) = h * tab.c[i], K(1, 1) = 1;
+    const double scale[3] = {h * h, h, 1.0};  // h^(2-k): the k-th time derivative of h² H(τ)
+    for (int f = 0; f < 2 + Sch::bubbles; ++f)  // X2 (H01), V1 (H11), bubbles: basis functions 2, 3, 4 ..
+      for (int k = 0; k < 3; ++k) K(k, 2 + f) = B[2 + f][k] * scale[k];
+  }
+  template <class Y>
+  Vec<double, 3 * r> jet(const Y& y) const {
+    Vec<double, 3 * r> q = Vec<double, 3 * r>::Zero();
+    for (int k = 0; k < 3; ++k)
+      for (int j = 0; j < cols; ++j)
+        if (K(k, j) != 0.0) q.template segment<r>(k * r) += K(k, j) * y.template segment<r>(j * r);
+    return q;
+  }
+};
+
+// An interval's smooth coordinates y = (x, v, X2, V1, bubbles).
+template <class Sch>
+Vec<double, FlatIntervalDerivatives<Sch>::ny> flat_coordinates_of(const Interval<Sch, double>& iv) {
+  constexpr int r = Sch::r, ny = FlatIntervalDerivatives<Sch>::ny;
+  Vec<double, ny> y;
+  y << iv.x, iv.v, iv.X2, iv.V1, iv.w.template head<ny - 4 * r>();
+  return y;
+}
+
+// FlatIntervalDerivatives' gradient alone, (∂L~/∂y, C): first derivatives of φ_i in the jet's
+// 3r directions, pushed through K_i (what a step's residual needs; no Hessian).
+template <class Sch>
+Vec<double, FlatIntervalDerivatives<Sch>::ne> flat_interval_gradient(const typename Sch::Model& model,
+                                                                    const Interval<Sch, double>& iv, double h) {
+  static_assert(Sch::d == 0, "the jet is linear in the interval's coordinates only without a group");
+  using D = FlatIntervalDerivatives<Sch>;
+  constexpr int r = Sch::r, m = Sch::m, ny = D::ny, nq = 3 * r, cols = FlatJetMap<Sch>::cols;
+  using T1 = Dual<double, nq>;
+  const auto& tab = GalerkinTable<Sch::degree, Sch::gauss>::get();
+  const Vec<double, ny> y = flat_coordinates_of(iv);
+  Vec<double, D::ne> out = Vec<double, D::ne>::Zero();
+  for (int i = 0; i < Sch::gauss; ++i) {
+    const double w = h * tab.b[i];
+    const FlatJetMap<Sch> K(h, i);
+    const Vec<double, nq> qv = K.jet(y);
+    Jet<typename Sch::Model, T1> q;
+    for (int a = 0; a < r; ++a)
+      q.p(a) = T1::variable(qv(a), a), q.dp(a) = T1::variable(qv(r + a), r + a),
+      q.ddp(a) = T1::variable(qv(2 * r + a), 2 * r + a);
+    T1 phi = model.template lagrangian<T1>(q);
+    if constexpr (m > 0) {
+      const Vec<T1, m> chi = model.template constraints<T1>(q);
+      for (int c = 0; c < m; ++c) {
+        phi = phi + iv.w(Sch::multipliers(i) + c) * chi(c);
+        out(ny + i * m + c) = w * chi(c).v;
+      }
+    }
+    for (int k = 0; k < 3; ++k)
+      for (int j = 0; j < cols; ++j)
+        if (K.K(k, j) != 0.0)
+          for (int a = 0; a < r; ++a) out(j * r + a) += (w * K.K(k, j)) * phi.d[k * r + a];
+  }
+  return out;
+}
+
 template <class Sch>
 FlatIntervalDerivatives<Sch> flat_interval_derivatives(const typename Sch::Model& model,
                                                        const Interval<Sch, double>& iv, double h) {
@@ -46,23 +116,14 @@ FlatIntervalDerivatives<Sch> flat_interval_derivatives(const typename Sch::Model
   using T2 = Dual<T1, nq>;
   const auto& tab = GalerkinTable<Sch::degree, Sch::gauss>::get();
 
-  Vec<double, ny> y;
-  y << iv.x, iv.v, iv.X2, iv.V1, iv.w.template head<ny - 4 * r>();
+  const Vec<double, ny> y = flat_coordinates_of(iv);
   D out;
   out.gradient.setZero();
   out.hessian.setZero();
   for (int i = 0; i < Sch::gauss; ++i) {
-    const auto& B = tab.basis[i];
-    const double tau = tab.c[i], w = h * tab.b[i];
-    Eigen::Matrix<double, 3, cols> K = Eigen::Matrix<double, 3, cols>::Zero();
-    K(0, 0) = 1, K(0, 1) = h * tau, K(1, 1) = 1;
-    for (int f = 0; f < 2 + nb; ++f)  // X2 (H01), V1 (H11), bubbles: basis functions 2, 3, 4 ..
-      for (int k = 0; k < 3; ++k) K(k, 2 + f) = B[2 + f][k] * std::pow(h, 2 - k);
-    // q = (K ⊗ I_r) y, block by block (K is sparse: its zeros are skipped below as well).
-    Vec<double, nq> qv = Vec<double, nq>::Zero();
-    for (int k = 0; k < 3; ++k)
-      for (int j = 0; j < cols; ++j)
-        if (K(k, j) != 0.0) qv.template segment<r>(k * r) += K(k, j) * y.template segment<r>(j * r);
+    const double w = h * tab.b[i];
+    const FlatJetMap<Sch> K(h, i);
+    const Vec<double, nq> qv = K.jet(y);
 
     // φ = ℓ + λ_i · χ on the jet, every jet coordinate seeded at both dual levels.
     Jet<C, T2> q;
@@ -93,8 +154,8 @@ FlatIntervalDerivatives<Sch> flat_interval_derivatives(const typename Sch::Model
     Eigen::Matrix<double, nq, ny> HM = Eigen::Matrix<double, nq, ny>::Zero();
     for (int k = 0; k < 3; ++k)
       for (int j = 0; j < cols; ++j) {
-        if (K(k, j) == 0.0) continue;
-        const double kj = K(k, j);
+        if (K.K(k, j) == 0.0) continue;
+        const double kj = K.K(k, j);
         out.gradient.template segment<r>(j * r) += (w * kj) * g.template segment<r>(k * r);
         HM.template middleCols<r>(j * r) += kj * H.template middleCols<r>(k * r);
         if constexpr (m > 0)
@@ -102,8 +163,8 @@ FlatIntervalDerivatives<Sch> flat_interval_derivatives(const typename Sch::Model
       }
     for (int k = 0; k < 3; ++k)
       for (int j = 0; j < cols; ++j)
-        if (K(k, j) != 0.0)
-          out.hessian.template block<r, ny>(j * r, 0) += (w * K(k, j)) * HM.template middleRows<r>(k * r);
+        if (K.K(k, j) != 0.0)
+          out.hessian.template block<r, ny>(j * r, 0) += (w * K.K(k, j)) * HM.template middleRows<r>(k * r);
   }
   if constexpr (m > 0)  // the (λ, y) block
     out.hessian.template bottomLeftCorner<nm, ny>() = out.hessian.template topRightCorner<ny, nm>().transpose();
@@ -140,6 +201,28 @@ struct FlatStepMaps {
     for (int k = 0; k < nz; ++k) unknowns(2 * r + k, k) = 1;
   }
 };
+
+// A_l g / h and A_r g / h for one interval's gradient g = (∂L~/∂y, C) (FlatStepMaps, written
+// out): the state's part of E_n, and interval n's part of E_n with its own rows.
+template <class Sch>
+Vec<double, Sch::variation> flat_left_rows(const Vec<double, FlatIntervalDerivatives<Sch>::ne>& g, double h) {
+  constexpr int r = Sch::r;
+  Vec<double, Sch::variation> E;
+  E << g.template segment<r>(2 * r) / h, g.template segment<r>(3 * r) / h;
+  return E;
+}
+
+template <class Sch>
+Vec<double, Sch::unknowns> flat_right_rows(const Vec<double, FlatIntervalDerivatives<Sch>::ne>& g, double h) {
+  constexpr int r = Sch::r, ne = FlatIntervalDerivatives<Sch>::ne;
+  const auto gx = g.template segment<r>(0), gv = g.template segment<r>(r);
+  const auto gX2 = g.template segment<r>(2 * r), gV1 = g.template segment<r>(3 * r);
+  Vec<double, Sch::unknowns> F;
+  F.template segment<r>(0) = h * gx - gX2 / h;
+  F.template segment<r>(r) = gv - (gX2 + gV1) / h;
+  F.template tail<ne - 4 * r>() = g.template tail<ne - 4 * r>() / h;
+  return F;
+}
 
 // A flow's step-to-step carry: interval n's derivatives at its solution are interval n's as the
 // state of step n + 1 (d = 0 only; nothing is carried with a group).

@@ -99,7 +99,7 @@ class GalerkinFlow {
     ChordMatrix<nz> chord;
     ChordMatrix<nz>* const chord_used = seed ? &chord : nullptr;
     StepCarry<Sch> carry;  // interval derivatives shared by consecutive steps
-    StepCarry<Sch>* const carry_used = affine_ ? nullptr : &carry;
+    StepCarry<Sch>* const carry_used = &carry;
     Eigen::Matrix<double, nz, ns> dz;
     double condition = 0;  // dz's step matrix's
     bool dz_current = false;
@@ -138,14 +138,20 @@ class GalerkinFlow {
       if (seed) {
         const Eigen::MatrixXd& S = out.sensitivity;
         next.resize(S.rows(), S.cols());
-        // The base node of interval n is the end of interval n-1.
+        // Column by column (each seed's column is contiguous): fixed-size products, vectorized;
+        // at these sizes GEMM's packing costs more than the product.
         const double h = h_;
-        next.middleRows(Sch::x_off, r) =
-            S.middleRows(Sch::x_off, r) + h * S.middleRows(Sch::v_off, r) + (h * h) * S.middleRows(Sch::X2_off, r);
-        next.middleRows(Sch::v_off, r) = S.middleRows(Sch::v_off, r) + h * S.middleRows(Sch::V1_off, r);
-        next.middleRows(Sch::Om_off, d) = S.middleRows(Sch::Om_off, d) + h * S.middleRows(Sch::O1_off, d);
-        // Coefficient-based: at these sizes (nz x ns times ns x seeds) GEMM's packing costs more than the product.
-        next.middleRows(Sch::X2_off, nz).noalias() = dz.lazyProduct(S.topRows(ns));
+        for (Eigen::Index j = 0; j < S.cols(); ++j) {
+          const Eigen::Map<const Vec<double, ns>> sj(S.col(j).data());
+          Eigen::Map<Vec<double, ns>> nj(next.col(j).data());
+          // The base node of interval n is the end of interval n-1.
+          nj.template segment<r>(Sch::x_off) = sj.template segment<r>(Sch::x_off) +
+                                               h * sj.template segment<r>(Sch::v_off) +
+                                               (h * h) * sj.template segment<r>(Sch::X2_off);
+          nj.template segment<r>(Sch::v_off) = sj.template segment<r>(Sch::v_off) + h * sj.template segment<r>(Sch::V1_off);
+          nj.template segment<d>(Sch::Om_off) = sj.template segment<d>(Sch::Om_off) + h * sj.template segment<d>(Sch::O1_off);
+          nj.template segment<nz>(Sch::X2_off).noalias() = dz * sj;
+        }
         if constexpr (d > 0) {
           if (with_group)  // g_n = g_{n-1} W_{n-1}:  δg_n = Ad_{W^{-1}} δg_{n-1} + h δW
             next.bottomRows(d) = G::Ad(G::inverse(s.W)) * S.bottomRows(d) + h * S.middleRows(Sch::W_off, d);

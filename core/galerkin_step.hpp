@@ -205,7 +205,7 @@ void evaluate_galerkin_step(const typename Sch::Model& model, double h, const In
                             const Interval<Sch, double>& z, bool with_state, const Vec<double, Sch::variation>* fixed,
                             Vec<double, Sch::unknowns>& F, Eigen::Matrix<double, Sch::unknowns, NO>& J,
                             StepCarry<Sch>* carry = nullptr) {
-  if constexpr (Sch::d == 0 && NO != Sch::unknowns) {
+  if constexpr (Sch::d == 0) {
     evaluate_galerkin_step_flat<Sch, NO>(model, h, state, z, with_state, fixed, F, J, carry);
   } else {
     (void)carry;
@@ -213,16 +213,27 @@ void evaluate_galerkin_step(const typename Sch::Model& model, double h, const In
   }
 }
 
+// F at z given the state's part of E_n (`fixed`). Without a group, `right_gradient` (if given)
+// receives interval n's gradient (∂L~/∂y, C) (galerkin_flat.hpp), from which F was formed.
 template <class Sch>
 Vec<double, Sch::unknowns> galerkin_step_residual(const typename Sch::Model& model, double h,
                                                   const Interval<Sch, double>& state, const Interval<Sch, double>& z,
-                                                  const Vec<double, Sch::variation>& fixed) {
+                                                  const Vec<double, Sch::variation>& fixed,
+                                                  Vec<double, FlatIntervalDerivatives<Sch>::ne>* right_gradient = nullptr) {
   constexpr int nv = Sch::variation, na = Sch::aux;
   Interval<Sch, double> left, right;
   galerkin_step_block(state, z, false, h, left, right);
   Vec<double, Sch::unknowns> F;
-  F.template head<nv>() = fixed + node_residual<Sch, double>(model, nullptr, &right, h);
-  F.template tail<na>() = aux_residual<Sch, double>(model, right, h);
+  if constexpr (Sch::d == 0) {  // the chain rule through the jet (galerkin_flat.hpp): first derivatives only
+    const Vec<double, FlatIntervalDerivatives<Sch>::ne> g = flat_interval_gradient<Sch>(model, right, h);
+    F = flat_right_rows<Sch>(g, h);
+    F.template head<nv>() += fixed;
+    if (right_gradient) *right_gradient = g;
+  } else {
+    (void)right_gradient;
+    F.template head<nv>() = fixed + node_residual<Sch, double>(model, nullptr, &right, h);
+    F.template tail<na>() = aux_residual<Sch, double>(model, right, h);
+  }
   return F;
 }
 
@@ -246,11 +257,15 @@ void apply_galerkin_correction(Interval<Sch, double>& z, const Vec<double, Sch::
 // (its base node included).
 // `chord`: a flow's factored step matrix, for chord iterations (newton_solve).
 // `carry`: the state's derivatives, when the flow has them (its part of E_n is read off them).
-// `affine`: the step equations are affine and `chord` is their matrix (newton_solve).
+// With `affine` (the step equations are affine and `chord` is their matrix, newton_solve) and
+// no group, the carry is moved on to interval n: its gradient is the one of the residual
+// evaluation plus the constant Hessian times the correction that followed (∇L~ is affine in
+// z), so the next step evaluates interval n's L~ once instead of twice. Otherwise the carry is
+// left for galerkin_step_sensitivity to update, or invalidated when it cannot be.
 template <class Sch>
 StepReport solve_galerkin_step(const typename Sch::Model& model, double h, const Interval<Sch, double>& state, int n,
                                const NewtonOptions& opt, Interval<Sch, double>& z,
-                               ChordMatrix<Sch::unknowns>* chord = nullptr, const StepCarry<Sch>* carry = nullptr,
+                               ChordMatrix<Sch::unknowns>* chord = nullptr, StepCarry<Sch>* carry = nullptr,
                                const Vec<double, Sch::unknowns>* predictor = nullptr, bool affine = false) {
   constexpr int r = Sch::r, d = Sch::d, nz = Sch::unknowns, nv = Sch::variation;
   z = state;
@@ -267,10 +282,9 @@ StepReport solve_galerkin_step(const typename Sch::Model& model, double h, const
   }
   Vec<double, nv> fixed;
   if constexpr (Sch::d == 0) {
-    if (carry && carry->valid)
-      fixed = (FlatStepMaps<Sch>(h).left.template topRows<nv>() * carry->interval.gradient) / h;
-    else
-      fixed = node_residual<Sch, double>(model, &state, nullptr, h);
+    fixed = flat_left_rows<Sch>(carry && carry->valid ? carry->interval.gradient
+                                                      : flat_interval_gradient<Sch>(model, state, h),
+                                h);
   } else {
     (void)carry;
     fixed = node_residual<Sch, double>(model, &state, nullptr, h);
@@ -282,13 +296,26 @@ StepReport solve_galerkin_step(const typename Sch::Model& model, double h, const
     rep.message = "step n=" + std::to_string(n) + ": the step equations evaluated to a non-finite number";
     return rep;
   }
-  return newton_solve<nz>(
+  // Interval n's gradient at the last residual evaluation and the corrections since (d = 0).
+  constexpr int ne = FlatIntervalDerivatives<Sch>::ne;
+  Vec<double, ne> g_right;
+  Vec<double, nz> moved = Vec<double, nz>::Zero();
+  bool have_gradient = false;
+  const StepReport rep = newton_solve<nz>(
       n, opt,
       [&](Vec<double, nz>& F, Eigen::Matrix<double, nz, nz>& J) {
         evaluate_galerkin_step<Sch, nz>(model, h, state, z, false, &fixed, F, J);
+        have_gradient = false;
       },
-      [&](Vec<double, nz>& F) { F = galerkin_step_residual<Sch>(model, h, state, z, fixed); },
-      [&](const Vec<double, nz>& dz) { apply_galerkin_correction<Sch>(z, dz, h); },
+      [&](Vec<double, nz>& F) {
+        F = galerkin_step_residual<Sch>(model, h, state, z, fixed, d == 0 ? &g_right : nullptr);
+        moved.setZero();
+        have_gradient = d == 0;
+      },
+      [&](const Vec<double, nz>& dz) {
+        apply_galerkin_correction<Sch>(z, dz, h);
+        moved += dz;
+      },
       [&] {
         Vec<double, nz> scale = Vec<double, nz>::Zero();
         scale.template segment<r>(0) = z.X2.cwiseAbs();
@@ -298,6 +325,15 @@ StepReport solve_galerkin_step(const typename Sch::Model& model, double h, const
         return scale;
       },
       chord, affine);
+  if constexpr (d == 0) {
+    if (affine && carry && carry->valid) {
+      if (rep.status == StepStatus::Converged && have_gradient)  // unknowns: interval coordinates 2r ..
+        carry->interval.gradient = g_right + carry->interval.hessian.template rightCols<ne - 2 * r>() * moved;
+      else
+        carry->valid = false;
+    }
+  }
+  return rep;
 }
 
 // dz/d(state) at a solved step (nz x ns), by the implicit function theorem. Optionally the step
