@@ -197,9 +197,9 @@ void evaluate_galerkin_step_nested(const typename Sch::Model& model, double h, c
   }
 }
 
-// Without a group the jet is linear in the intervals' coordinates, and with the state's columns
-// the chain rule through it is cheaper (galerkin_flat.hpp); otherwise nested duals, which for the
-// step matrix alone are narrower (unknowns x node directions) than the jet's Hessian.
+// Without a group the jet is linear in the intervals' coordinates and the chain rule through it
+// is cheaper (galerkin_flat.hpp), for the step matrix alone as well (measured: electron Galerkin
+// 4 step 6.7 → 4.5 µs, Galerkin 6 23 → 7.7 µs, bench_galerkin_step); with a group, nested duals.
 template <class Sch, int NO>
 void evaluate_galerkin_step(const typename Sch::Model& model, double h, const Interval<Sch, double>& state,
                             const Interval<Sch, double>& z, bool with_state, const Vec<double, Sch::variation>* fixed,
