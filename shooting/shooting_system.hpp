@@ -175,15 +175,49 @@ class ShootingSystem : public NonlinearSystem {
     runs.resize(S);
     starts.resize(S);
     Jr.resize(S);
+    for (int i = 0; i < S; ++i) {
+      starts[i] = A::retract(bvp_, refs_[i], Eigen::VectorXd(Minv_ * x.segment(i * n, n)), sensitivities ? &Jr[i] : nullptr);
+      if (sensitivities) Jr[i] = Jr[i] * Minv_;  // d(tangent at the start)/d(unknowns)
+    }
     // The flow propagates the unknowns' own directions (Jr), not the state's: in the nodal
     // scheme a direction such as "move p_{2k-1} alone" is a (2k-1)-th difference of size
     // h^{-(2k-1)}, whose sensitivity would be recombined into O(1) entries afterwards by
     // cancellation, losing ~(2k-1) log10(1/h) digits twice.
-    for_each_segment(S, true, [&](int i) {
-      starts[i] = A::retract(bvp_, refs_[i], Eigen::VectorXd(Minv_ * x.segment(i * n, n)), sensitivities ? &Jr[i] : nullptr);
-      if (sensitivities) Jr[i] = Jr[i] * Minv_;  // d(tangent at the start)/d(unknowns)
+    auto work = [&](int i) {
       runs[i] = A::run(flow_, starts[i], starts_[i], starts_[i + 1] - starts_[i], sensitivities ? &Jr[i] : nullptr);
-    });
+    };
+    const int T = std::max(1, std::min(S, threads_ > 0 ? threads_ : static_cast<int>(std::thread::hardware_concurrency())));
+    if (T == 1) {
+      for (int i = 0; i < S; ++i) {
+        work(i);
+        if (on_segment_) on_segment_(i + 1, S);
+      }
+    } else {
+      // Stripe t of the segments on thread t; the calling thread takes stripe 0 and any stripe
+      // whose thread could not be created (no thread is left unjoined, no exception escapes one).
+      std::vector<std::exception_ptr> errors(T);
+      auto stripe = [&](int t) {
+        try {
+          for (int i = t; i < S; i += T) {
+            work(i);
+            if (t == 0 && on_segment_) on_segment_(i + 1, S);
+          }
+        } catch (...) {
+          errors[t] = std::current_exception();
+        }
+      };
+      std::vector<std::thread> pool;
+      try {
+        for (int t = 1; t < T; ++t) pool.emplace_back(stripe, t);
+      } catch (const std::system_error&) {  // e.g. EAGAIN under a thread or memory limit
+      }
+      const int started = static_cast<int>(pool.size()) + 1;
+      stripe(0);
+      for (int t = started; t < T; ++t) stripe(t);
+      for (auto& th : pool) th.join();
+      for (const auto& e : errors)
+        if (e) std::rethrow_exception(e);
+    }
     last_failure_.clear();
     for (int i = 0; i < S; ++i)
       if (!runs[i].report.ok()) {
@@ -218,44 +252,6 @@ class ShootingSystem : public NonlinearSystem {
   }
 
  private:
-  // work(i) for every segment i, stripe t of the segments on thread t (segments are independent:
-  // each i writes its own slots). The calling thread takes stripe 0 and any stripe whose thread
-  // could not be created (no thread is left unjoined, no exception escapes one). `progress`:
-  // report to on_segment_ from the calling thread.
-  template <class Work>
-  void for_each_segment(int S, bool progress, Work&& work) const {
-    const int T = std::max(1, std::min(S, threads_ > 0 ? threads_ : static_cast<int>(std::thread::hardware_concurrency())));
-    if (T == 1) {
-      for (int i = 0; i < S; ++i) {
-        work(i);
-        if (progress && on_segment_) on_segment_(i + 1, S);
-      }
-      return;
-    }
-    std::vector<std::exception_ptr> errors(T);
-    auto stripe = [&](int t) {
-      try {
-        for (int i = t; i < S; i += T) {
-          work(i);
-          if (progress && t == 0 && on_segment_) on_segment_(i + 1, S);
-        }
-      } catch (...) {
-        errors[t] = std::current_exception();
-      }
-    };
-    std::vector<std::thread> pool;
-    try {
-      for (int t = 1; t < T; ++t) pool.emplace_back(stripe, t);
-    } catch (const std::system_error&) {  // e.g. EAGAIN under a thread or memory limit
-    }
-    const int started = static_cast<int>(pool.size()) + 1;
-    stripe(0);
-    for (int t = started; t < T; ++t) stripe(t);
-    for (auto& th : pool) th.join();
-    for (const auto& e : errors)
-      if (e) std::rethrow_exception(e);
-  }
-
   // The conditions (unscaled) at x, with their Jacobian when J is given. The last evaluation is
   // kept: the solver asks again for what the setup (row tolerances) already computed at the guess.
   bool evaluate(const Eigen::VectorXd& x, Eigen::VectorXd& F, SparseJacobian* J) {
@@ -302,22 +298,18 @@ class ShootingSystem : public NonlinearSystem {
     F.segment(row, R.size()) = R;
     if (J) top[0] = JB * Jr[0];
     row += R.size();
-    // Continuity i: end of segment i minus start of segment i+1 (in parallel: its block products
-    // are as much work as a short segment's flow).
-    const int first_continuity = row;
-    for_each_segment(S - 1, false, [&](int i) {
-      const int r0 = first_continuity + i * n;
+    for (int i = 0; i + 1 < S; ++i) {  // continuity: end of segment i minus start of segment i+1
       const State e = A::end_state(runs[i]);
-      F.segment(r0, n) = M_ * A::difference(bvp_, e, starts[i + 1]);
+      F.segment(row, n) = M_ * A::difference(bvp_, e, starts[i + 1]);
       if (J) {
         Eigen::MatrixXd De, Ds;
         A::difference_jacobians(bvp_, e, starts[i + 1], De, Ds);
         bottom[i] = M_ * De * runs[i].sensitivity;
         top[i + 1] = M_ * Ds * Jr[i + 1];
-        first_row[i + 1] = r0;
+        first_row[i + 1] = row;
       }
-    });
-    row += (S - 1) * n;
+      row += n;
+    }
     const State e = A::end_state(runs[S - 1]);
     A::boundary_block(bvp_, End::Terminal, e, R, J ? &JB : nullptr);
     F.segment(row, R.size()) = R;
