@@ -1,6 +1,7 @@
 // Solve time against N (issue 9): multiple shooting with segments "auto" (100 steps each) and
 // the structured linear algebra, from N = 10^3 to 10^6, one and two threads. The electron on the
 // cubic Galerkin scheme (order 4, no roundoff floor: converges at tolerance 1e-10 at every N),
+// the beanie on the cubic Galerkin scheme (tolerance 1e-10; V = 1 - cos ψ, the scene's data),
 // the electron (N <= 10^4) and the beanie (N <= 4000) on the paper's windows (second-order
 // closure) at tolerance 1e-6: finer grids fall below the nodal scheme's roundoff floor (~u/h^3).
 // Counters: converged, iterations, unknowns, and the peak resident memory of the process so far
@@ -71,14 +72,31 @@ void electron_paper(benchmark::State& state) {
   timed_solves(state, bvp, guess, 1e-6);
 }
 
+// The beanie scene's data (examples/scenes/beanie.json): ψ from rest at 0 to rest at 1, the body
+// starting with Ω12 = (0.5, 0.2), θ(T) = 1.
+void beanie_data(BeanieBoundary& s, BeanieBoundary& e) {
+  s.psi = 0.0, s.psi_dot = 0.0, s.theta = 0.0, s.x = 0.0, s.y = 0.0, s.Omega1 = 0.5, s.Omega2 = 0.2;
+  e.psi = 1.0, e.psi_dot = 0.0, e.theta = 1.0;
+}
+
+void beanie_galerkin(benchmark::State& state) {
+  const int N = static_cast<int>(state.range(0));
+  BeanieModel model;
+  model.par = {1.0, 1.0, 0.5, 1.0};
+  BeanieBoundary s, e;
+  beanie_data(s, e);
+  const auto bvp = beanie_galerkin_bvp<3>(model, kT, N, s, e);
+  const auto guess = beanie_galerkin_guess<3>(bvp, s, e);
+  timed_solves(state, bvp, guess, 1e-10);
+}
+
 void beanie_paper(benchmark::State& state) {
   const int N = static_cast<int>(state.range(0));
   BeanieControl b;
   b.par = {1.0, 1.0, 0.5, 1.0};
   b.variant = BeanieConstraints::ExactRotation;
-  BeanieBoundary s, e;  // bench_shooting's well-posed data
-  s.psi = 0.0, s.psi_dot = 0.0, s.theta = 0.0, s.x = 0.0, s.y = 0.0, s.Omega1 = 0.5, s.Omega2 = 0.2;
-  e.psi = 1.0, e.psi_dot = 0.0, e.theta = 1.0;
+  BeanieBoundary s, e;
+  beanie_data(s, e);
   const auto bvp = beanie_bvp(b, kT, N, s, e, Closure::SecondOrder);
   const auto guess = beanie_guess(bvp, s, e);
   timed_solves(state, bvp, guess, 1e-6);
@@ -89,6 +107,8 @@ int main(int argc, char** argv) {
   for (int threads : {1, 2}) {
     for (int N : {1000, 10000, 100000, 1000000})
       benchmark::RegisterBenchmark("BM_ElectronGalerkin4", electron_galerkin)->Args({N, threads})->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+    for (int N : {1000, 10000, 100000, 1000000})
+      benchmark::RegisterBenchmark("BM_BeanieGalerkin4", beanie_galerkin)->Args({N, threads})->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
     for (int N : {1000, 3000, 10000})
       benchmark::RegisterBenchmark("BM_ElectronPaper", electron_paper)->Args({N, threads})->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
     for (int N : {1000, 2000, 4000})

@@ -31,6 +31,11 @@ class NonlinearSystem {
   // a system whose rows are scaled for the stopping test (e.g. by per-row tolerances) returns
   // the norm of the unscaled rows here.
   virtual double progress_norm(const Eigen::VectorXd& F) const { return F.lpNorm<Eigen::Infinity>(); }
+  // A hint from the solver: the Jacobian will be asked for at the point of the next residual
+  // evaluation (a full Newton step that will not converge there). A system that gets both from
+  // one sweep (shooting: one flow with sensitivities instead of one without, then one with) may
+  // compute it with the residual. Ignored by default.
+  virtual void expect_jacobian(bool) {}
 };
 
 enum class Backend { Kinsol, Nlopt };

@@ -90,7 +90,8 @@ class ShootingSystem : public NonlinearSystem {
 
   // Residual rows may be scaled by w (none by default: the conditions are solved in their own units).
   bool residual(const Eigen::VectorXd& x, Eigen::VectorXd& F) override {
-    if (!evaluate(x, F, nullptr)) return false;
+    SparseJacobian J;
+    if (!evaluate(x, F, expect_jacobian_ ? &J : nullptr)) return false;
     if (w_.size() == F.size()) F.array() *= w_.array();
     return true;
   }
@@ -108,6 +109,8 @@ class ShootingSystem : public NonlinearSystem {
   const SparseJacobian& last_jacobian() const { return last_J_; }
   const Eigen::VectorXd& last_jacobian_point() const { return last_J_x_; }
   void set_row_scaling(const Eigen::VectorXd& w) { w_ = w; }
+  // The Jacobian at the next residual's point is computed with it (one seeded sweep) and kept.
+  void expect_jacobian(bool yes) override { expect_jacobian_ = yes; }
   double progress_norm(const Eigen::VectorXd& F) const override {
     return w_.size() == F.size() ? F.cwiseQuotient(w_).lpNorm<Eigen::Infinity>() : F.lpNorm<Eigen::Infinity>();
   }
@@ -155,8 +158,17 @@ class ShootingSystem : public NonlinearSystem {
   bool raw_residual(const Eigen::VectorXd& x, Eigen::VectorXd& F) { return evaluate(x, F, nullptr); }
 
   // The segment runs at x: those of the last evaluation when it was at x (moved out of the
-  // memo, which keeps its residual and Jacobian), else propagated anew.
+  // memo, which keeps its residual and Jacobian), else propagated anew. Runs with sensitivities
+  // are not reused: their steps are chord-solved to the step tolerance, and the trajectory a
+  // solve returns comes from Newton-solved steps, accurate to roundoff, like its residual
+  // (core/newton.hpp), so the memo is refreshed without sensitivities first.
   bool runs_at(const Eigen::VectorXd& x, std::vector<typename A::Run>& runs, std::vector<State>& starts) {
+    if (memo_ok_ && memo_has_J_ && memo_x_.size() == x.size() && memo_x_ == x) {
+      Eigen::VectorXd F;
+      memo_has_J_ = false;
+      memo_ok_ = evaluate_uncached(x, F, nullptr);
+      if (memo_ok_) memo_F_ = F;
+    }
     if (memo_ok_ && memo_x_.size() == x.size() && memo_x_ == x && !memo_runs_.empty()) {
       runs = std::move(memo_runs_);
       starts = std::move(memo_starts_);
@@ -335,6 +347,7 @@ class ShootingSystem : public NonlinearSystem {
   SparseJacobian last_J_;
   Eigen::VectorXd last_J_x_;
   bool memo_has_J_ = false, memo_ok_ = false;
+  bool expect_jacobian_ = false;
 };
 
 }  // namespace detail

@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
+#include <vector>
 
 using namespace lpshoot;
 
@@ -41,7 +43,59 @@ struct Noisy : NonlinearSystem {
   }
 };
 
+// F(x) = exp(x - a) - 1 per component (Newton converges quadratically, e_next ~ e² / 2),
+// recording KINSOL's expect_jacobian hints: the hint in force at each residual evaluation, and
+// the points where the Jacobian was asked for.
+struct Recorded : NonlinearSystem {
+  Eigen::VectorXd a;
+  bool hint = false;
+  std::vector<std::pair<Eigen::VectorXd, bool>> residuals;  // point, hinted
+  std::vector<Eigen::VectorXd> jacobians;
+  int size() const override { return static_cast<int>(a.size()); }
+  void expect_jacobian(bool yes) override { hint = yes; }
+  bool residual(const Eigen::VectorXd& x, Eigen::VectorXd& F) override {
+    residuals.emplace_back(x, hint);
+    F = ((x - a).array().exp() - 1.0).matrix();
+    return true;
+  }
+  bool jacobian(const Eigen::VectorXd& x, SparseJacobian& J) override {
+    jacobians.push_back(x);
+    J = Eigen::MatrixXd((x - a).array().exp().matrix().asDiagonal()).sparseView();
+    return true;
+  }
+};
+
 }  // namespace
+
+// The hint lets a shooting system compute the Jacobian in the residual's sweep (one flow with
+// sensitivities instead of two flows): it must be given only where KINSOL then asks for the
+// Jacobian, and not at the converged iterate, whose Jacobian is never asked for.
+TEST(NonlinearSolver, JacobianHintsPrecedeJacobianRequestsOnly) {
+  Recorded f;
+  f.a = Eigen::Vector3d(0.5, -1.0, 2.0);
+  Eigen::VectorXd x = f.a + Eigen::Vector3d(0.8, -0.6, 0.4);
+  SolverOptions opt;
+  opt.tolerance = 1e-12;
+  const SolverOutcome out = solve_nonlinear(f, x, opt);
+  ASSERT_EQ(out.status, SolverStatus::Converged) << out.message;
+  EXPECT_LT((x - f.a).lpNorm<Eigen::Infinity>(), 1e-12);
+  int hinted = 0;
+  for (const auto& [point, was_hinted] : f.residuals) {
+    if (!was_hinted) continue;
+    ++hinted;
+    bool asked = false;
+    for (const Eigen::VectorXd& j : f.jacobians) asked = asked || j == point;
+    EXPECT_TRUE(asked) << "a hinted residual at a point where no Jacobian was asked for";
+  }
+  for (const Eigen::VectorXd& j : f.jacobians) {
+    bool announced = false;
+    for (const auto& [point, was_hinted] : f.residuals) announced = announced || (was_hinted && point == j);
+    EXPECT_TRUE(announced) << "a Jacobian asked for where no residual was hinted";
+  }
+  EXPECT_GE(hinted, 3);  // 5 iterations from |e| = 0.8: 0.25, 0.029, 4e-4, 8e-8, 3e-15
+  EXPECT_FALSE(f.residuals.back().second) << "the converged iterate was hinted";
+  EXPECT_FALSE(f.hint) << "the hint is left set after the solve";
+}
 
 TEST(NonlinearSolver, LineSearchTakesOverWhenFullNewtonStepsDiverge) {
   // Full Newton on atan from a distance of 2: 2 -> -3.54 -> 13.95 -> -279 (diverges).
