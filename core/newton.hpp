@@ -198,10 +198,13 @@ StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian,
     }
     // At the roundoff floor (tiny h: terms of size 1/h cancel to an O(1) residual) F is rounding
     // noise and stops decreasing; the correction it yields is then ~ cond(J) u relative, which
-    // may exceed step_tolerance. A fresh-Jacobian step on a stalled residual whose correction is
-    // within that noise (never beyond 1e-8 relative) is converged: another iteration cannot do
-    // better.
-    if (refresh && rep.residual > 0.25 * last_residual) {
+    // may exceed step_tolerance. A fresh-Jacobian step on a stalled residual, or whose correction
+    // did not shrink 4-fold (exact Newton contracts quadratically above the noise; a noisy
+    // residual can dip below the last one and return, tests/test_extremes.cpp), with a
+    // correction within that noise (never beyond 1e-8 relative) is converged: another iteration
+    // cannot do better.
+    const double size = dz.template lpNorm<Eigen::Infinity>();
+    if (refresh && (rep.residual > 0.25 * last_residual || size > 0.25 * last_step)) {
       const double noise = std::min(1e-8, 64 * eps * rep.condition);
       if (((dz.cwiseAbs().array() - (opt.step_tolerance + noise) * (1.0 + scale.array())) <= 0.0).all()) {
         rep.status = StepStatus::Converged;
@@ -209,7 +212,6 @@ StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian,
       }
     }
     last_residual = rep.residual;
-    const double size = dz.template lpNorm<Eigen::Infinity>();
     refresh = refresh ? false : !(size <= 0.25 * last_step);  // after a chord step that contracts too slowly
     last_step = size;
   }

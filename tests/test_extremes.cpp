@@ -30,6 +30,13 @@ void tiny_steps(int N) {
   const int steps = 300;
   const SE2::Element<double> g0{0.3, Eigen::Vector2d(0.5, -0.2)};
   const auto start = test_support::beanie_interval_with_multipliers<S>(model, T, N);
+  // With sensitivities (as shooting runs flows) each step starts with chord steps on the step
+  // before's matrix, and a fresh-Jacobian step can land below a noisy residual that the next
+  // chord step returns to: the stagnation must be seen in the corrections too.
+  const Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(BeanieGalerkin<S>::state, BeanieGalerkin<S>::state);
+  const auto seeded = GalerkinFlow<BeanieGalerkin<S>>(model, h, NewtonOptions{}).run(start, steps, &seed, g0);
+  ASSERT_TRUE(seeded.report.ok()) << "h = " << h << ", with sensitivities: " << seeded.report.message;
+  ASSERT_TRUE(seeded.sensitivity.allFinite());
   const auto run = GalerkinFlow<BeanieGalerkin<S>>(model, h, NewtonOptions{}).run(start, steps, nullptr, g0);
   ASSERT_TRUE(run.report.ok()) << "h = " << h << ": " << run.report.message;
   const auto J = galerkin_spatial_momentum<BeanieGalerkin<S>>(model, run.trajectory);
@@ -52,6 +59,34 @@ TEST(TinySteps, GalerkinOrderFourStepsConvergeDownToHEqualsOneMillionth) {
 
 TEST(TinySteps, GalerkinOrderSixStepsConvergeDownToHEqualsOneMillionth) {
   for (int N : {20000, 200000, 2000000}) tiny_steps<4>(N);
+}
+
+// The beanie scene's problem at N = 10⁵ (h = 2e-5), shooting's segment 289 from its guess, with
+// sensitivities: at step 28955 the fresh-Jacobian step reached a residual of 1.5e-12, the chord
+// step after it went back to 7e-12 (rounding), and the two alternated for 20 iterations with
+// corrections of 3e-12 relative, above the step tolerance and within rounding. Found by
+// bench_scaling (BM_BeanieGalerkin4/100000), which then reported a failed flow from the guess.
+TEST(TinySteps, AlternatingNoisyResidualsAreRecognisedAsTheRoundoffFloor) {
+  BeanieModel model;
+  model.par = {1.0, 1.0, 0.5, 1.0};
+  BeanieBoundary s, e;
+  s.psi = 0.0, s.psi_dot = 0.0, s.theta = 0.0, s.x = 0.0, s.y = 0.0, s.Omega1 = 0.5, s.Omega2 = 0.2;
+  e.psi = 1.0, e.psi_dot = 0.0, e.theta = 1.0;
+  const int N = 100000, first = 28900, steps = 100;
+  const auto bvp = beanie_galerkin_bvp<3>(model, 2.0, N, s, e);
+  const auto guess = beanie_galerkin_guess<3>(bvp, s, e);
+  const Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(BeanieGalerkin<3>::state, BeanieGalerkin<3>::state);
+  const GalerkinFlow<BeanieGalerkin<3>> flow(model, bvp.h());
+  const auto run = flow.run(guess.trajectory.intervals[first], steps, &seed, SE2::identity<double>(), first, false);
+  ASSERT_TRUE(run.report.ok()) << run.report.message;
+  EXPECT_LE(run.report.max_iterations, 8);
+  // The steps still solve their equations: the plain flow (Newton-solved steps) ends at the same
+  // interval to well within the step tolerance's accumulation (100 steps x 1e-12 relative).
+  const auto plain = flow.run(guess.trajectory.intervals[first], steps, nullptr, SE2::identity<double>(), first, false);
+  ASSERT_TRUE(plain.report.ok()) << plain.report.message;
+  const auto& a = run.trajectory.intervals.back();
+  const auto& b = plain.trajectory.intervals.back();
+  EXPECT_LT((a.x - b.x).norm() + (a.v - b.v).norm() + (a.Om - b.Om).norm(), 1e-9);
 }
 
 TEST(RankDiagnosis, ANonFiniteJacobianHasNoRank) {
