@@ -16,6 +16,7 @@ packages=(
   python3                            # the CLI fuzz test (standard library only)
   python3-dev python3-numpy pybind11-dev   # the Python module
   python3-pytest python3-matplotlib        # its tests and examples
+  python3-scipy                      # bench/compare_scipy.py (scipy's solve_bvp, the peer)
   libopenmpi-dev openmpi-bin         # lpshoot study under mpirun
 )
 
