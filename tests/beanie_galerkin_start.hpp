@@ -8,6 +8,13 @@
 
 namespace lpshoot::test_support {
 
+// The well-posed data of the beanie scene (examples/scenes/beanie.json): ψ from rest at 0 to rest
+// at 1, g(0) = e, Ω12(0) = (0.5, 0.2), θ(T) = 1.
+inline void beanie_scene_boundary(problems::BeanieBoundary& s, problems::BeanieBoundary& e) {
+  s.psi = 0, s.psi_dot = 0, s.theta = 0, s.x = 0, s.y = 0, s.Omega1 = 0.5, s.Omega2 = 0.2;
+  e.psi = 1, e.psi_dot = 0, e.theta = 1;
+}
+
 template <int S = 3>
 Interval<problems::BeanieGalerkin<S>, double> beanie_interval_with_multipliers(const problems::BeanieModel& model,
                                                                                double T, int N) {

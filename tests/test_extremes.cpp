@@ -70,8 +70,7 @@ TEST(TinySteps, AlternatingNoisyResidualsAreRecognisedAsTheRoundoffFloor) {
   BeanieModel model;
   model.par = {1.0, 1.0, 0.5, 1.0};
   BeanieBoundary s, e;
-  s.psi = 0.0, s.psi_dot = 0.0, s.theta = 0.0, s.x = 0.0, s.y = 0.0, s.Omega1 = 0.5, s.Omega2 = 0.2;
-  e.psi = 1.0, e.psi_dot = 0.0, e.theta = 1.0;
+  test_support::beanie_scene_boundary(s, e);
   const int N = 100000, first = 28900, steps = 100;
   const auto bvp = beanie_galerkin_bvp<3>(model, 2.0, N, s, e);
   const auto guess = beanie_galerkin_guess<3>(bvp, s, e);

@@ -134,8 +134,7 @@ TEST(GalerkinBeanie, CubicIsOrderFourInEveryOutput) {
   BeanieModel model;
   model.par = {1.0, 1.0, 0.5, 1.0};
   BeanieBoundary s, e;
-  s.psi = 0, s.psi_dot = 0, s.theta = 0, s.x = 0, s.y = 0, s.Omega1 = 0.5, s.Omega2 = 0.2;
-  e.psi = 1, e.psi_dot = 0, e.theta = 1;
+  test_support::beanie_scene_boundary(s, e);
   const double T = 2.0;
   const Eigen::Vector2d Om12T = SO2::rotation(-1.0) * Eigen::Vector2d(0.5, 0.2);
   struct E {
