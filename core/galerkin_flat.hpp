@@ -24,11 +24,12 @@
 namespace lpshoot {
 
 // One interval's L~ = L0 + λ · C as a function of (y, λ): gradient and Hessian (the (λ, λ)
-// block is zero).
+// block is zero). y: the interval's smooth coordinates in the state's layout (without a group
+// x, v, X2, V1, bubbles; with one also Ω, O1 and δ, galerkin_group.hpp).
 template <class Sch>
-struct FlatIntervalDerivatives {
+struct IntervalDerivatives {
   static constexpr int r = Sch::r, nm = multiplier_count<Sch>;
-  static constexpr int ny = Sch::state - nm;  // (x, v, X2, V1, bubbles): the state's own layout
+  static constexpr int ny = Sch::state - nm;
   static constexpr int ne = ny + nm;
   Vec<double, ne> gradient;                  // (∂L~/∂y, C)
   Eigen::Matrix<double, ne, ne> hessian;     // [[∇²_y L~, ∂C/∂y], [∂C/∂yᵀ, 0]]
@@ -61,20 +62,20 @@ struct FlatJetMap {
 
 // An interval's smooth coordinates y = (x, v, X2, V1, bubbles).
 template <class Sch>
-Vec<double, FlatIntervalDerivatives<Sch>::ny> flat_coordinates_of(const Interval<Sch, double>& iv) {
-  constexpr int r = Sch::r, ny = FlatIntervalDerivatives<Sch>::ny;
+Vec<double, IntervalDerivatives<Sch>::ny> flat_coordinates_of(const Interval<Sch, double>& iv) {
+  constexpr int r = Sch::r, ny = IntervalDerivatives<Sch>::ny;
   Vec<double, ny> y;
   y << iv.x, iv.v, iv.X2, iv.V1, iv.w.template head<ny - 4 * r>();
   return y;
 }
 
-// FlatIntervalDerivatives' gradient alone, (∂L~/∂y, C): first derivatives of φ_i in the jet's
+// IntervalDerivatives' gradient alone, (∂L~/∂y, C): first derivatives of φ_i in the jet's
 // 3r directions, pushed through K_i (what a step's residual needs; no Hessian).
 template <class Sch>
-Vec<double, FlatIntervalDerivatives<Sch>::ne> flat_interval_gradient(const typename Sch::Model& model,
+Vec<double, IntervalDerivatives<Sch>::ne> flat_interval_gradient(const typename Sch::Model& model,
                                                                     const Interval<Sch, double>& iv, double h) {
   static_assert(Sch::d == 0, "the jet is linear in the interval's coordinates only without a group");
-  using D = FlatIntervalDerivatives<Sch>;
+  using D = IntervalDerivatives<Sch>;
   constexpr int r = Sch::r, m = Sch::m, ny = D::ny, nq = 3 * r, cols = FlatJetMap<Sch>::cols;
   using T1 = Dual<double, nq>;
   const auto& tab = GalerkinTable<Sch::degree, Sch::gauss>::get();
@@ -105,11 +106,11 @@ Vec<double, FlatIntervalDerivatives<Sch>::ne> flat_interval_gradient(const typen
 }
 
 template <class Sch>
-FlatIntervalDerivatives<Sch> flat_interval_derivatives(const typename Sch::Model& model,
+IntervalDerivatives<Sch> flat_interval_derivatives(const typename Sch::Model& model,
                                                        const Interval<Sch, double>& iv, double h) {
   static_assert(Sch::d == 0, "the jet is linear in the interval's coordinates only without a group");
   using C = typename Sch::Model;
-  using D = FlatIntervalDerivatives<Sch>;
+  using D = IntervalDerivatives<Sch>;
   constexpr int r = Sch::r, m = Sch::m, nb = Sch::bubbles, ny = D::ny, ne = D::ne, nm = D::nm, nq = 3 * r;
   constexpr int cols = 4 + nb;  // x, v, X2, V1, bubbles (scalar columns of K)
   using T1 = Dual<double, nq>;
@@ -176,7 +177,7 @@ FlatIntervalDerivatives<Sch> flat_interval_derivatives(const typename Sch::Model
 // multiplier rows (= the unknowns' layout without a group).
 template <class Sch>
 struct FlatStepMaps {
-  using D = FlatIntervalDerivatives<Sch>;
+  using D = IntervalDerivatives<Sch>;
   static constexpr int r = Sch::r, ny = D::ny, ne = D::ne, nz = Sch::unknowns, ns = Sch::state;
   Eigen::Matrix<double, nz, ne> left, right;  // A_l, A_r
   Eigen::Matrix<double, ne, nz> unknowns;     // S_z
@@ -205,7 +206,7 @@ struct FlatStepMaps {
 // A_l g / h and A_r g / h for one interval's gradient g = (∂L~/∂y, C) (FlatStepMaps, written
 // out): the state's part of E_n, and interval n's part of E_n with its own rows.
 template <class Sch>
-Vec<double, Sch::variation> flat_left_rows(const Vec<double, FlatIntervalDerivatives<Sch>::ne>& g, double h) {
+Vec<double, Sch::variation> flat_left_rows(const Vec<double, IntervalDerivatives<Sch>::ne>& g, double h) {
   constexpr int r = Sch::r;
   Vec<double, Sch::variation> E;
   E << g.template segment<r>(2 * r) / h, g.template segment<r>(3 * r) / h;
@@ -213,8 +214,8 @@ Vec<double, Sch::variation> flat_left_rows(const Vec<double, FlatIntervalDerivat
 }
 
 template <class Sch>
-Vec<double, Sch::unknowns> flat_right_rows(const Vec<double, FlatIntervalDerivatives<Sch>::ne>& g, double h) {
-  constexpr int r = Sch::r, ne = FlatIntervalDerivatives<Sch>::ne;
+Vec<double, Sch::unknowns> flat_right_rows(const Vec<double, IntervalDerivatives<Sch>::ne>& g, double h) {
+  constexpr int r = Sch::r, ne = IntervalDerivatives<Sch>::ne;
   const auto gx = g.template segment<r>(0), gv = g.template segment<r>(r);
   const auto gX2 = g.template segment<r>(2 * r), gV1 = g.template segment<r>(3 * r);
   Vec<double, Sch::unknowns> F;
@@ -225,11 +226,11 @@ Vec<double, Sch::unknowns> flat_right_rows(const Vec<double, FlatIntervalDerivat
 }
 
 // A flow's step-to-step carry: interval n's derivatives at its solution are interval n's as the
-// state of step n + 1 (d = 0 only; nothing is carried with a group).
+// state of step n + 1 (galerkin_group.hpp with a group).
 template <class Sch>
 struct StepCarry {
   bool valid = false;
-  std::conditional_t<Sch::d == 0, FlatIntervalDerivatives<Sch>, char> interval{};
+  IntervalDerivatives<Sch> interval{};
 };
 
 // evaluate_galerkin_step (galerkin_step.hpp) for d = 0: same arguments and results. `carry`, when
@@ -245,7 +246,7 @@ void evaluate_galerkin_step_flat(const typename Sch::Model& model, double h, con
   Interval<Sch, double> right = z;
   const Interval<Sch, double> b = next_interval_base(state, h);
   right.x = b.x, right.v = b.v;
-  const FlatIntervalDerivatives<Sch> dr = flat_interval_derivatives<Sch>(model, right, h);
+  const IntervalDerivatives<Sch> dr = flat_interval_derivatives<Sch>(model, right, h);
   const double inv_h = 1.0 / h;
   F.noalias() = inv_h * (maps.right * dr.gradient);
   const Eigen::Matrix<double, nz, FlatStepMaps<Sch>::ne> AH = inv_h * (maps.right * dr.hessian);
@@ -254,7 +255,7 @@ void evaluate_galerkin_step_flat(const typename Sch::Model& model, double h, con
   if (fixed) {
     F.template head<nv>() += *fixed;
   } else {
-    const FlatIntervalDerivatives<Sch> dl =
+    const IntervalDerivatives<Sch> dl =
         carry && carry->valid ? carry->interval : flat_interval_derivatives<Sch>(model, state, h);
     F.noalias() += inv_h * (maps.left * dl.gradient);
     if constexpr (state_cols)

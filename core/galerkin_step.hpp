@@ -10,6 +10,7 @@
 
 #include "galerkin.hpp"
 #include "galerkin_flat.hpp"
+#include "galerkin_group.hpp"
 #include "newton.hpp"
 
 namespace lpshoot {
@@ -67,32 +68,6 @@ void galerkin_step_block(const Interval<Sch, double>& state, const Interval<Sch,
     right.W = G::compose(right.W, G::template exp<T>(zeta));
   }
   for (int a = 0; a < na; ++a) right.w(a) = var(z.w(a), 2 * r + 2 * d + a, zl, 0);
-}
-
-// The state interval with its smooth tangent coordinates (all but the multipliers, the last
-// Q m) seeded in columns first .. first + state - Q m - 1 of T.
-template <class Sch, class T>
-Interval<Sch, T> seeded_state(const Interval<Sch, double>& state, double h, int first) {
-  using G = typename Sch::Group;
-  constexpr int r = Sch::r, d = Sch::d, nb = Sch::aux - multiplier_count<Sch>;
-  Interval<Sch, T> s = state.template cast<T>();
-  for (int a = 0; a < r; ++a) {
-    s.x(a) = T::variable(state.x(a), first + Sch::x_off + a);
-    s.v(a) = T::variable(state.v(a), first + Sch::v_off + a);
-    s.X2(a) = T::variable(state.X2(a), first + Sch::X2_off + a);
-    s.V1(a) = T::variable(state.V1(a), first + Sch::V1_off + a);
-  }
-  for (int a = 0; a < d; ++a) {
-    s.Om(a) = T::variable(state.Om(a), first + Sch::Om_off + a);
-    s.O1(a) = T::variable(state.O1(a), first + Sch::O1_off + a);
-  }
-  if constexpr (d > 0) {
-    typename G::template Tangent<T> delta;
-    for (int a = 0; a < d; ++a) delta(a) = T::variable(0.0, first + Sch::W_off + a) * h;  // W exp(h δ)
-    s.W = G::compose(s.W, G::template exp<T>(delta));
-  }
-  for (int a = 0; a < nb; ++a) s.w(a) = T::variable(state.w(a), first + Sch::aux_off + a);
-  return s;
 }
 
 // F = (E_n, interval n's equations) at z and its derivatives: columns are the unknowns, then (if
@@ -199,7 +174,11 @@ void evaluate_galerkin_step_nested(const typename Sch::Model& model, double h, c
 
 // Without a group the jet is linear in the intervals' coordinates and the chain rule through it
 // is cheaper (galerkin_flat.hpp), for the step matrix alone as well (measured: electron Galerkin
-// 4 step 6.7 → 4.5 µs, Galerkin 6 23 → 7.7 µs, bench_galerkin_step); with a group, nested duals.
+// 4 step 6.7 → 4.5 µs, Galerkin 6 23 → 7.7 µs, bench_galerkin_step). With a group, a step's
+// sensitivity comes from each interval's Hessian (galerkin_group.hpp); so does its step matrix
+// alone when the interval has bubbles, otherwise nested duals in the unknowns and the node
+// perturbations are as cheap (beanie, plain flow per step: Galerkin 4 92 µs from the Hessian
+// against 87 µs nested, Galerkin 6 193 against 250 µs; bench_galerkin_step).
 template <class Sch, int NO>
 void evaluate_galerkin_step(const typename Sch::Model& model, double h, const Interval<Sch, double>& state,
                             const Interval<Sch, double>& z, bool with_state, const Vec<double, Sch::variation>* fixed,
@@ -207,6 +186,13 @@ void evaluate_galerkin_step(const typename Sch::Model& model, double h, const In
                             StepCarry<Sch>* carry = nullptr) {
   if constexpr (Sch::d == 0) {
     evaluate_galerkin_step_flat<Sch, NO>(model, h, state, z, with_state, fixed, F, J, carry);
+  } else if constexpr (NO == Sch::unknowns + Sch::state) {
+    if (with_state && !fixed)
+      evaluate_galerkin_step_group<Sch, NO>(model, h, state, z, nullptr, F, J, carry);
+    else
+      evaluate_galerkin_step_nested<Sch, NO>(model, h, state, z, with_state, fixed, F, J);
+  } else if (fixed && Sch::bubbles > 0) {
+    evaluate_galerkin_step_group<Sch, NO>(model, h, state, z, fixed, F, J, nullptr);
   } else {
     (void)carry;
     evaluate_galerkin_step_nested<Sch, NO>(model, h, state, z, with_state, fixed, F, J);
@@ -219,13 +205,13 @@ template <class Sch>
 Vec<double, Sch::unknowns> galerkin_step_residual(const typename Sch::Model& model, double h,
                                                   const Interval<Sch, double>& state, const Interval<Sch, double>& z,
                                                   const Vec<double, Sch::variation>& fixed,
-                                                  Vec<double, FlatIntervalDerivatives<Sch>::ne>* right_gradient = nullptr) {
+                                                  Vec<double, IntervalDerivatives<Sch>::ne>* right_gradient = nullptr) {
   constexpr int nv = Sch::variation, na = Sch::aux;
   Interval<Sch, double> left, right;
   galerkin_step_block(state, z, false, h, left, right);
   Vec<double, Sch::unknowns> F;
   if constexpr (Sch::d == 0) {  // the chain rule through the jet (galerkin_flat.hpp): first derivatives only
-    const Vec<double, FlatIntervalDerivatives<Sch>::ne> g = flat_interval_gradient<Sch>(model, right, h);
+    const Vec<double, IntervalDerivatives<Sch>::ne> g = flat_interval_gradient<Sch>(model, right, h);
     F = flat_right_rows<Sch>(g, h);
     F.template head<nv>() += fixed;
     if (right_gradient) *right_gradient = g;
@@ -286,8 +272,8 @@ StepReport solve_galerkin_step(const typename Sch::Model& model, double h, const
                                                       : flat_interval_gradient<Sch>(model, state, h),
                                 h);
   } else {
-    (void)carry;
-    fixed = node_residual<Sch, double>(model, &state, nullptr, h);
+    fixed = carry && carry->valid ? group_left_rows<Sch>(carry->interval.gradient, h)
+                                  : node_residual<Sch, double>(model, &state, nullptr, h);
   }
   if (!all_finite(fixed.data(), nv)) {
     StepReport rep;
@@ -297,7 +283,7 @@ StepReport solve_galerkin_step(const typename Sch::Model& model, double h, const
     return rep;
   }
   // Interval n's gradient at the last residual evaluation and the corrections since (d = 0).
-  constexpr int ne = FlatIntervalDerivatives<Sch>::ne;
+  constexpr int ne = IntervalDerivatives<Sch>::ne;
   Vec<double, ne> g_right;
   Vec<double, nz> moved = Vec<double, nz>::Zero();
   bool have_gradient = false;

@@ -7,6 +7,7 @@
 #pragma once
 
 #include "groups.hpp"
+#include "hessian_scalar.hpp"
 #include "scalar_tower.hpp"
 #include "taylor.hpp"
 
@@ -108,7 +109,12 @@ Eigen::Matrix<T, G::dim, G::dim> right_jacobian_inverse(const typename G::templa
     const Eigen::Matrix<D, d, d> R = invert(detail::right_jacobian_direct<G, D>(z));
     Eigen::Matrix<T, d, d> out;
     for (int i = 0; i < d; ++i)
-      for (int j = 0; j < d; ++j) out(i, j) = detail::lift_multivariate<T>(R(i, j), zeta);
+      for (int j = 0; j < d; ++j) {
+        if constexpr (detail::is_hess<T>::value)
+          out(i, j) = detail::lift_multivariate_hess<detail::is_hess<T>::width>(R(i, j), zeta);
+        else
+          out(i, j) = detail::lift_multivariate<T>(R(i, j), zeta);
+      }
     return out;
   }
 }

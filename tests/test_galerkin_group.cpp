@@ -1,0 +1,126 @@
+// Galerkin steps with a group from each interval's gradient and Hessian (core/galerkin_group.hpp):
+// the second-order scalar Hess against nested duals, and the step's equations and derivatives
+// (with the group's bracket terms) against the nested-dual evaluation at generic points.
+#include <lpshoot/core/hessian_scalar.hpp>
+
+#include "beanie_galerkin_start.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+using namespace lpshoot;
+using namespace lpshoot::problems;
+
+namespace {
+
+// Every operation Hess implements, mixed so that each second derivative is non-zero.
+template <class T>
+T mixed_function(const std::array<T, 4>& x) {
+  using std::atan2, std::cos, std::exp, std::log, std::pow, std::sin, std::sqrt, std::tanh;
+  const T a = sin(x[0]) * cos(x[1]) / (2.0 + x[2] * x[2]);
+  const T b = exp(0.3 * x[3]) * log(1.5 + x[0] * x[1]) - sqrt(1.0 + x[2] * x[3] * x[3]);
+  const T c = tanh(x[1] - x[3]) * pow(1.2 + x[0] * x[0], 1.5) + atan2(x[2] + 0.1, 1.0 + x[3] - x[1]);
+  return a * b + c - 3.0 / (4.0 + x[1]) + abs(x[0] - 2.0);
+}
+
+TEST(HessScalar, ValueGradientAndHessianMatchNestedDuals) {
+  constexpr int n = 4;
+  using H = Hess<n>;
+  using D2 = Dual<Dual<double, n>, n>;
+  const double at[n] = {0.3, -0.7, 0.45, 1.1};
+  std::array<H, n> xh;
+  std::array<D2, n> xd;
+  for (int i = 0; i < n; ++i) {
+    xh[i] = H::variable(at[i], i);
+    xd[i] = D2::variable(Dual<double, n>::variable(at[i], i), i);
+  }
+  const H fh = mixed_function(xh);
+  const D2 fd = mixed_function(xd);
+  EXPECT_NEAR(fh.v, fd.v.v, 1e-15);
+  double worst = 0;
+  for (int i = 0; i < n; ++i) {
+    worst = std::max(worst, std::abs(fh.g[i] - fd.v.d[i]));
+    for (int j = 0; j < n; ++j) {
+      EXPECT_NEAR(fd.d[i].d[j], fd.d[j].d[i], 1e-13);  // the reference itself is symmetric
+      worst = std::max(worst, std::abs(fh.hessian(i, j) - fd.d[i].d[j]));
+    }
+  }
+  std::printf("Hess<4> against Dual<Dual<4>,4>: max difference %.2e\n", worst);
+  EXPECT_LT(worst, 1e-13);
+  EXPECT_NE(fh.hessian(0, 3), 0.0);
+}
+
+// An interval with every coordinate generic: W away from the identity, non-zero increments,
+// bubbles and multipliers.
+template <class Sch>
+Interval<Sch, double> generic_interval(const BeanieModel& model, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  Interval<Sch, double> iv = test_support::beanie_interval_with_multipliers<Sch::degree>(model, 2.0, 40);
+  for (int a = 0; a < Sch::r; ++a) iv.x(a) += u(rng), iv.v(a) += u(rng), iv.X2(a) = u(rng), iv.V1(a) = u(rng);
+  for (int a = 0; a < Sch::d; ++a) iv.Om(a) += u(rng), iv.O1(a) = u(rng);
+  iv.W = SE2::exp<double>(Eigen::Vector3d(u(rng), u(rng), u(rng)));
+  for (int a = 0; a < Sch::aux; ++a) iv.w(a) = 0.5 * u(rng);
+  return iv;
+}
+
+// F and J with the state's columns from interval Hessians (with and without a carried state)
+// against nested duals: equal to roundoff. A sign error in a bracket term or in A_r's group block
+// shows as an O(1) relative difference.
+template <int S>
+void expect_same_step(double h) {
+  using Sch = BeanieGalerkin<S>;
+  constexpr int nz = Sch::unknowns, ns = Sch::state;
+  BeanieModel model;
+  model.par = {1.0, 1.0, 0.5, 1.0};
+  std::mt19937 rng(11);
+  double worst = 0, bracket_part = 0;
+  for (int trial = 0; trial < 5; ++trial) {
+    const auto state = generic_interval<Sch>(model, rng), z = generic_interval<Sch>(model, rng);
+    Vec<double, nz> F1, F2, F3;
+    Eigen::Matrix<double, nz, nz + ns> J1, J2, J3;
+    evaluate_galerkin_step_nested<Sch, nz + ns>(model, h, state, z, true, nullptr, F1, J1);
+    evaluate_galerkin_step_group<Sch, nz + ns>(model, h, state, z, nullptr, F2, J2, nullptr);
+    StepCarry<Sch> carry;
+    carry.interval = group_interval_derivatives<Sch>(model, state, h);
+    carry.valid = true;
+    // The state's part of E_n from its gradient (group_left_rows) equals node_residual's.
+    const Vec<double, Sch::variation> fixed = node_residual<Sch, double>(model, &state, nullptr, h);
+    const Vec<double, Sch::variation> left_rows = group_left_rows<Sch>(carry.interval.gradient, h);
+    evaluate_galerkin_step_group<Sch, nz + ns>(model, h, state, z, nullptr, F3, J3, &carry);
+    const double fs = F1.cwiseAbs().maxCoeff(), js = J1.cwiseAbs().maxCoeff();
+    worst = std::max({worst, (F1 - F2).cwiseAbs().maxCoeff() / fs, (J1 - J2).cwiseAbs().maxCoeff() / js,
+                      (F1 - F3).cwiseAbs().maxCoeff() / fs, (J1 - J3).cwiseAbs().maxCoeff() / js});
+    worst = std::max(worst, (fixed - left_rows).cwiseAbs().maxCoeff() / fs);
+    // The step matrix alone (a step's Newton), given the state's part of E_n.
+    Vec<double, nz> G1, G2;
+    Eigen::Matrix<double, nz, nz> K1, K2;
+    evaluate_galerkin_step_nested<Sch, nz>(model, h, state, z, false, &fixed, G1, K1);
+    evaluate_galerkin_step_group<Sch, nz>(model, h, state, z, &fixed, G2, K2, nullptr);
+    worst = std::max({worst, (G1 - G2).cwiseAbs().maxCoeff() / G1.cwiseAbs().maxCoeff(),
+                      (K1 - K2).cwiseAbs().maxCoeff() / K1.cwiseAbs().maxCoeff()});
+    // The bracket terms are really exercised: without them the η rows would differ.
+    const Eigen::Matrix<double, Sch::d, Sch::d> B =
+        bracket_form<SE2>(carry.interval.gradient.template segment<Sch::d>(Sch::W_off));
+    bracket_part = std::max(bracket_part, 0.5 * B.cwiseAbs().maxCoeff() / js);
+    // The carry now holds interval n's derivatives.
+    const auto dr_expected = [&] {
+      Interval<Sch, double> right = z;
+      const auto b = next_interval_base(state, h);
+      right.x = b.x, right.v = b.v, right.Om = b.Om;
+      return group_interval_derivatives<Sch>(model, right, h);
+    }();
+    EXPECT_EQ(carry.interval.gradient, dr_expected.gradient);
+  }
+  std::printf("beanie degree %d, h = %g: interval Hessians vs nested duals, max relative difference %.2e "
+              "(bracket terms %.2e of |J|)\n",
+              S, h, worst, bracket_part);
+  EXPECT_LT(worst, 1e-12);
+  EXPECT_GT(bracket_part, 1e-6);
+}
+
+TEST(GalerkinGroupStep, CubicMatchesNestedDuals) { expect_same_step<3>(0.05); }
+TEST(GalerkinGroupStep, QuarticWithBubblesMatchesNestedDuals) { expect_same_step<4>(0.05); }
+TEST(GalerkinGroupStep, LargeStepMatchesNestedDuals) { expect_same_step<3>(0.5); }
+
+}  // namespace
