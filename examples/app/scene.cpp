@@ -666,20 +666,24 @@ Scene parse_scene(const json& j, const std::string& path) {
 }  // namespace
 
 std::string resource_problem(const Scene& s) {
-  // Measured peak memory is 0.4-0.6 kB per step (trajectory, step sensitivities, CSV columns);
-  // multiple shooting also holds its dense Jacobian, its LU and the diagnostics' copies (issue 9
-  // makes that structured). 12 unknowns per segment bound every scheme's state.
+  // Measured peak memory is 0.4-1.3 kB per step (trajectory, step sensitivities, CSV columns;
+  // the beanie on Galerkin 4 at N = 10^5: 1.2 kB). Multiple shooting also holds its Jacobian:
+  // with KINSOL sparse (block bidiagonal, about 2 x 22 non-zeros per row for the largest state,
+  // the beanie's on Galerkin 6; the matrix, KLU's factors and the diagnosis' copies: ~4 copies
+  // of 12 bytes each), with NLopt's SLSQP dense (4 copies of the square matrix).
   const double per_step = 1024.0;
-  const double unknowns = s.shooting.method == ShootingMethod::Multiple ? 12.0 * s.shooting.segments : 0.0;
-  const double bytes = per_step * s.N + 4 * 8.0 * unknowns * unknowns;
+  const double unknowns = s.shooting.method == ShootingMethod::Multiple ? 22.0 * s.shooting.segments : 0.0;
+  const bool dense = s.shooting.solver.backend == Backend::Nlopt;
+  const double jacobian = dense ? 4 * 8.0 * unknowns * unknowns : 4 * 12.0 * 44.0 * unknowns;
+  const double bytes = per_step * s.N + jacobian;
   const double available = 0.75 * double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
   if (!(available > 0) || bytes <= available) return "";
   char buf[400];
-  if (4 * 8.0 * unknowns * unknowns > per_step * s.N)
+  if (dense && jacobian > per_step * s.N)
     std::snprintf(buf, sizeof buf,
-                  "%d steps in %d multiple-shooting segments need an estimated %.3g GB (a dense Jacobian of about "
-                  "%.0f unknowns), more than 3/4 of this machine's %.3g GB; use fewer segments (solver.segments), "
-                  "single shooting, or a smaller N",
+                  "%d steps in %d multiple-shooting segments need an estimated %.3g GB (NLopt's dense Jacobian of "
+                  "about %.0f unknowns), more than 3/4 of this machine's %.3g GB; use fewer segments "
+                  "(solver.segments), the kinsol backend, or a smaller N",
                   s.N, s.shooting.segments, bytes / 1e9, unknowns, available / 0.75 / 1e9);
   else
     std::snprintf(buf, sizeof buf,

@@ -451,6 +451,8 @@ TEST_F(BadInput, EachClassFailsCleanlyNamingTheKey) {
        "parameters.B.99999999999999999999 must be a number given in the scene's parameters"},
       {"huge_N", "solve " + e + "--set horizon.N=1e9", "horizon.N: 1000000000 steps need an estimated"},
       {"sweep_huge_N", "sweep " + e + "--N 2147483647", "--N: N = 2147483647"},
+      {"nlopt_dense_jacobian", "solve " + b + "--set solver.backend=nlopt --set horizon.N=1000000 --set solver.segments=50000",
+       "horizon.N: 1000000 steps in 50000 multiple-shooting segments need an estimated"},
       {"empty_out", "solve '" + scene("electron") + "' --out ''", "--out: the output directory is empty"},
       {"simulate_loose_tolerance", "simulate '" + scene("beanie_free") + "' --out OUT --set solver.tolerance=1",
        "solver.tolerance: must be between 1e-15 and 1e-6"},
@@ -523,6 +525,18 @@ TEST_F(BadInput, InvalidJsonNamesTheLine) {
   const Outcome o = run_cli("check '" + (work / "broken.json").string() + "'", work);
   EXPECT_EQ(o.code, 2);
   EXPECT_NE(o.err.find("broken.json: invalid JSON: parse error at line 4"), std::string::npos) << o.err;
+}
+
+// KINSOL's Jacobian is sparse: a million steps in automatic segments fit in memory (the dense
+// estimate once refused them), NLopt's dense one in as many segments does not.
+TEST_F(BadInput, MemoryEstimateFollowsTheBackendsJacobian) {
+  const fs::path work = scratch("memory");
+  const std::string b = "'" + scene("beanie") + "' --set 'scheme={\"discretization\":\"galerkin\"}' ";
+  const Outcome sparse = run_cli("check " + b + "--set horizon.N=1000000 --set solver.segments=auto", work);
+  EXPECT_EQ(sparse.code, 0) << sparse.err;
+  const Outcome dense = run_cli("check " + b + "--set horizon.N=1000000 --set solver.segments=50000 --set solver.backend=nlopt", work);
+  EXPECT_EQ(dense.code, 2) << dense.err;
+  EXPECT_NE(dense.err.find("NLopt's dense Jacobian"), std::string::npos) << dense.err;
 }
 
 TEST_F(BadInput, CheckAcceptsEveryExampleScene) {
