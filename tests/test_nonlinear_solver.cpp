@@ -127,6 +127,32 @@ TEST(NonlinearSolver, FullNewtonStepsConvergeQuadraticallyFromAFairStart) {
   }
 }
 
+// Noise 30x the tolerance (the beanie's Galerkin flows at N = 10^6, tolerance 1e-10): full steps
+// stall there, and the solve stops without a line search, which could not go below the noise.
+TEST(NonlinearSolver, AStallJustAboveTheToleranceEndsWithoutALineSearch) {
+  struct NearFloor : NonlinearSystem {
+    int calls = 0;
+    int size() const override { return 2; }
+    bool residual(const Eigen::VectorXd& x, Eigen::VectorXd& F) override {
+      ++calls;
+      F = x + 3e-9 * Eigen::Vector2d(std::sin(12.9898 * calls), std::cos(78.233 * calls));
+      return true;
+    }
+    bool jacobian(const Eigen::VectorXd&, SparseJacobian& J) override {
+      J = Eigen::MatrixXd::Identity(2, 2).sparseView();
+      return true;
+    }
+  } f;
+  Eigen::VectorXd x = Eigen::Vector2d(1.0, -2.0);
+  SolverOptions opt;
+  opt.tolerance = 1e-10;
+  const SolverOutcome out = solve_nonlinear(f, x, opt);
+  EXPECT_NE(out.status, SolverStatus::Converged);
+  EXPECT_LT(out.residual_norm, 1e-8);
+  EXPECT_NE(out.message.find("no line search"), std::string::npos) << out.message;
+  EXPECT_LE(f.calls, out.iterations + 4) << out.message;  // the full steps' evaluations and the final check
+}
+
 TEST(NonlinearSolver, ANoiseFloorAboveTheToleranceIsNotConvergence) {
   Noisy f;
   Eigen::VectorXd x = Eigen::Vector2d(1.0, -2.0);
