@@ -27,14 +27,15 @@ struct Atan : NonlinearSystem {
   }
 };
 
-// F(x) = x + noise of size 1e-7 that changes with every evaluation: the residual cannot go below
-// ~1e-7, so a tolerance of 1e-10 cannot be met.
+// F(x) = x + noise of size `amplitude` (1e-7 by default) that changes with every evaluation: the
+// residual cannot go below it, so a tolerance of 1e-10 cannot be met.
 struct Noisy : NonlinearSystem {
   int calls = 0;
+  double amplitude = 1e-7;
   int size() const override { return 2; }
   bool residual(const Eigen::VectorXd& x, Eigen::VectorXd& F) override {
     ++calls;
-    F = x + 1e-7 * Eigen::Vector2d(std::sin(12.9898 * calls), std::cos(78.233 * calls));
+    F = x + amplitude * Eigen::Vector2d(std::sin(12.9898 * calls), std::cos(78.233 * calls));
     return true;
   }
   bool jacobian(const Eigen::VectorXd&, SparseJacobian& J) override {
@@ -130,19 +131,8 @@ TEST(NonlinearSolver, FullNewtonStepsConvergeQuadraticallyFromAFairStart) {
 // Noise 30x the tolerance (the beanie's Galerkin flows at N = 10^6, tolerance 1e-10): full steps
 // stall there, and the solve stops without a line search, which could not go below the noise.
 TEST(NonlinearSolver, AStallJustAboveTheToleranceEndsWithoutALineSearch) {
-  struct NearFloor : NonlinearSystem {
-    int calls = 0;
-    int size() const override { return 2; }
-    bool residual(const Eigen::VectorXd& x, Eigen::VectorXd& F) override {
-      ++calls;
-      F = x + 3e-9 * Eigen::Vector2d(std::sin(12.9898 * calls), std::cos(78.233 * calls));
-      return true;
-    }
-    bool jacobian(const Eigen::VectorXd&, SparseJacobian& J) override {
-      J = Eigen::MatrixXd::Identity(2, 2).sparseView();
-      return true;
-    }
-  } f;
+  Noisy f;
+  f.amplitude = 3e-9;
   Eigen::VectorXd x = Eigen::Vector2d(1.0, -2.0);
   SolverOptions opt;
   opt.tolerance = 1e-10;
