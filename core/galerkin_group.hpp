@@ -109,6 +109,29 @@ Vec<double, Sch::variation> group_left_rows(const Vec<double, IntervalDerivative
   return E;
 }
 
+// A_r for an interval with group increment W: rows E (the node at the interval's base, perturbed
+// as in perturb_node), then the interval's own rows (∂L~/∂bubbles, C); columns the interval's
+// coordinates (state layout). Its η block is −Ad_{W^{-1}}ᵀ.
+template <class Sch>
+Eigen::Matrix<double, Sch::unknowns, IntervalDerivatives<Sch>::ne> group_right_map(
+    double h, const typename Sch::Group::template Element<double>& W) {
+  using G = typename Sch::Group;
+  constexpr int r = Sch::r, d = Sch::d, nz = Sch::unknowns, nv = Sch::variation, ne = IntervalDerivatives<Sch>::ne;
+  constexpr int eta = 2 * r + d;  // first η row
+  Eigen::Matrix<double, nz, ne> Ar = Eigen::Matrix<double, nz, ne>::Zero();
+  for (int a = 0; a < r; ++a) {
+    Ar(a, Sch::x_off + a) = h * h, Ar(a, Sch::X2_off + a) = -1;
+    Ar(r + a, Sch::v_off + a) = h, Ar(r + a, Sch::X2_off + a) = -1, Ar(r + a, Sch::V1_off + a) = -1;
+  }
+  const Eigen::Matrix<double, d, d> A = G::Ad(G::inverse(W));  // Ad_{W^{-1}}
+  for (int a = 0; a < d; ++a) {
+    Ar(2 * r + a, Sch::Om_off + a) = h, Ar(2 * r + a, Sch::O1_off + a) = -1;
+    for (int b = 0; b < d; ++b) Ar(eta + a, Sch::W_off + b) = -A(b, a);
+  }
+  for (int k = 0; k < Sch::aux; ++k) Ar(nv + k, Sch::aux_off + k) = 1;
+  return Ar;
+}
+
 // F and J of the step (evaluate_galerkin_step's contract): from interval n's derivatives at z
 // and, for the state's columns (NO = unknowns + state) or without `fixed` (the state's part of
 // E_n), the state's (`carry`, when valid; computed otherwise). With `carry`, on return it holds
@@ -131,18 +154,8 @@ void evaluate_galerkin_step_group(const typename Sch::Model& model, double h, co
   right.x = base.x, right.v = base.v, right.Om = base.Om;
   const D dr = group_interval_derivatives<Sch>(model, right, h);
 
-  // A_r (rows: E, then interval n's own rows); A_l below.
-  Eigen::Matrix<double, nz, ne> Ar = Eigen::Matrix<double, nz, ne>::Zero();
-  for (int a = 0; a < r; ++a) {
-    Ar(a, Sch::x_off + a) = h * h, Ar(a, Sch::X2_off + a) = -1;
-    Ar(r + a, Sch::v_off + a) = h, Ar(r + a, Sch::X2_off + a) = -1, Ar(r + a, Sch::V1_off + a) = -1;
-  }
+  const Eigen::Matrix<double, nz, ne> Ar = group_right_map<Sch>(h, z.W);  // A_l below
   const Eigen::Matrix<double, d, d> A = G::Ad(G::inverse(z.W));  // Ad_{W_n^{-1}}
-  for (int a = 0; a < d; ++a) {
-    Ar(2 * r + a, Sch::Om_off + a) = h, Ar(2 * r + a, Sch::O1_off + a) = -1;
-    for (int b = 0; b < d; ++b) Ar(eta + a, Sch::W_off + b) = -A(b, a);
-  }
-  for (int k = 0; k < Sch::aux; ++k) Ar(nv + k, Sch::aux_off + k) = 1;
 
   const double inv_h = 1.0 / h;
   F.noalias() = inv_h * (Ar * dr.gradient);

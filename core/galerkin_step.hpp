@@ -239,8 +239,8 @@ void apply_galerkin_correction(Interval<Sch, double>& z, const Vec<double, Sch::
 }
 
 // Solves step n (interval n from interval n-1 = `state`) by Newton from the predictor "interval
-// n-1's unknowns", or `predictor` (unknowns' layout; without a group); on return z is interval n
-// (its base node included).
+// n-1's unknowns", or `predictor` (unknowns' layout, ζ: W = W_{n-1} exp(h ζ)); on return z is
+// interval n (its base node included).
 // `chord`: a flow's factored step matrix, for chord iterations (newton_solve).
 // `carry`: the state's derivatives, when the flow has them (its part of E_n is read off them).
 // With `affine` (the step equations are affine and `chord` is their matrix, newton_solve) and
@@ -257,14 +257,16 @@ StepReport solve_galerkin_step(const typename Sch::Model& model, double h, const
   z = state;
   const Interval<Sch, double> base = next_interval_base(state, h);
   z.x = base.x, z.v = base.v, z.Om = base.Om;
-  if constexpr (d == 0) {  // with a group the predictor is interval n-1's unknowns
-    if (predictor) {
-      z.X2 = predictor->template segment<r>(0);
-      z.V1 = predictor->template segment<r>(r);
-      z.w = predictor->template tail<Sch::aux>();
+  if (predictor) {  // the unknowns' layout; ζ moves W from interval n-1's W
+    z.X2 = predictor->template segment<r>(0);
+    z.V1 = predictor->template segment<r>(r);
+    if constexpr (d > 0) {
+      using G = typename Sch::Group;
+      z.O1 = predictor->template segment<d>(2 * r);
+      const typename G::template Tangent<double> step = h * predictor->template segment<d>(2 * r + d);
+      z.W = G::compose(state.W, G::template exp<double>(step));
     }
-  } else {
-    (void)predictor;
+    z.w = predictor->template tail<Sch::aux>();
   }
   Vec<double, nv> fixed;
   if constexpr (Sch::d == 0) {

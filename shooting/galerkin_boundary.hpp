@@ -12,6 +12,7 @@
 
 #include "boundary.hpp"
 
+#include <lpshoot/core/galerkin_end_rows.hpp>
 #include <lpshoot/core/galerkin_flow.hpp>
 
 namespace lpshoot {
@@ -90,16 +91,21 @@ std::string check_counting(const GalerkinBVP<Sch>& bvp) {
 
 // Residuals of one end's conditions in scalar T, from the end interval (the first, or the last)
 // and g at its base node. The initial end starts with the first interval's own equations.
+// `action_rows`, if given, holds the rows that come from the action, (E, own rows) at the
+// initial end and E at the terminal one (galerkin_end_rows, with their derivatives in T);
+// otherwise they are computed here.
 template <class Sch, class T>
 std::vector<T> galerkin_boundary_residuals(const GalerkinBVP<Sch>& bvp, End e, const Interval<Sch, T>& iv,
-                                           const typename Sch::Group::template Element<T>& g_base) {
+                                           const typename Sch::Group::template Element<T>& g_base,
+                                           const Vec<T, Sch::unknowns>* action_rows = nullptr) {
   using G = typename Sch::Group;
   constexpr int r = Sch::r, d = Sch::d;
   const double h = bvp.h();
   std::vector<T> out;
   const bool initial = e == End::Initial;
   if (initial) {
-    const Vec<T, Sch::aux> a = aux_residual<Sch, T>(bvp.model, iv, h);
+    const Vec<T, Sch::aux> a = action_rows ? Vec<T, Sch::aux>(action_rows->template segment<Sch::aux>(Sch::variation))
+                                           : aux_residual<Sch, T>(bvp.model, iv, h);
     for (int i = 0; i < Sch::aux; ++i) out.push_back(a(i));
   }
   Vec<T, 2 * r + d> node;
@@ -117,7 +123,10 @@ std::vector<T> galerkin_boundary_residuals(const GalerkinBVP<Sch>& bvp, End e, c
         out.push_back(G::log(G::compose(G::template cast<T>(G::inverse(c.target)), g))(c.component - 2 * r - d));
         break;
       case ConditionKind::Natural:
-        if (!have_natural) {
+        if (!have_natural && action_rows) {
+          natural = action_rows->template head<Sch::variation>();
+          have_natural = true;
+        } else if (!have_natural) {
           natural = initial ? node_residual<Sch, T>(bvp.model, nullptr, &iv, h) : node_residual<Sch, T>(bvp.model, &iv, nullptr, h);
           have_natural = true;
         }

@@ -140,10 +140,31 @@ struct GalerkinScheme {
     v.segment<Sch::aux>(Sch::aux_off) = x.iv.w.cwiseAbs().array().max(1.0);
     return v;
   }
+  // The rows that come from the action (natural conditions, the first interval's own equations)
+  // and their derivatives from the end interval's gradient and Hessian (galerkin_end_rows); the
+  // fixed rows in duals over the end state's tangent. Without J, in doubles.
   static void boundary_block(const BVP& bvp, End e, const State& x, Eigen::VectorXd& R, Eigen::MatrixXd* J) {
+    if (!J) {
+      const std::vector<double> res = galerkin_boundary_residuals(bvp, e, x.iv, x.g);
+      R = Eigen::Map<const Eigen::VectorXd>(res.data(), static_cast<Eigen::Index>(res.size()));
+      return;
+    }
     using T = Dual<double, size>;
-    Interval<Sch, T> iv = x.iv.template cast<T>();
     const double h = bvp.h();
+    const bool initial = e == End::Initial;
+    bool from_action = initial && Sch::aux > 0;
+    for (const auto& c : bvp.conditions) from_action = from_action || (c.end == e && c.kind == ConditionKind::Natural);
+    Vec<T, Sch::unknowns> action_rows;
+    if (from_action) {
+      Vec<double, Sch::unknowns> Ra;
+      Eigen::Matrix<double, Sch::unknowns, ns> Ja;
+      galerkin_end_rows<Sch>(bvp.model, x.iv, h, initial, Ra, Ja);
+      for (int i = 0; i < Sch::unknowns; ++i) {
+        action_rows(i) = T(Ra(i));
+        for (int c = 0; c < ns; ++c) action_rows(i).d[c] = Ja(i, c);  // none on g (the symmetry)
+      }
+    }
+    Interval<Sch, T> iv = x.iv.template cast<T>();
     for (int a = 0; a < r; ++a) {
       iv.x(a) = T::variable(x.iv.x(a), Sch::x_off + a);
       iv.v(a) = T::variable(x.iv.v(a), Sch::v_off + a);
@@ -165,13 +186,12 @@ struct GalerkinScheme {
       iv.W = G::compose(iv.W, G::template exp<T>(dw));
       g = G::compose(g, G::template exp<T>(dg));
     }
-    const std::vector<T> res = galerkin_boundary_residuals(bvp, e, iv, g);
+    const std::vector<T> res = galerkin_boundary_residuals(bvp, e, iv, g, from_action ? &action_rows : nullptr);
     R.resize(res.size());
-    if (J) J->resize(res.size(), size);
+    J->resize(res.size(), size);
     for (size_t i = 0; i < res.size(); ++i) {
       R(i) = res[i].v;
-      if (J)
-        for (int c = 0; c < size; ++c) (*J)(i, c) = res[i].d[c];
+      for (int c = 0; c < size; ++c) (*J)(i, c) = res[i].d[c];
     }
   }
   static std::vector<std::string> initial_equation_names(const BVP&) { return galerkin_initial_equation_names<Sch>(); }

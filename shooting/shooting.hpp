@@ -68,6 +68,7 @@ struct ShootingResult {
   double cost = 0;                         // the discrete cost (Σ L_d without multiplier terms)
   double momentum_drift = 0;               // relative max |J_n - J_first| of the discrete momentum map
   bool propagated_starts = false;          // multiple shooting started from the forward sweep
+  bool stalled_at_floor = false;           // not converged: stalled at the flows' roundoff floor
   bool ok() const { return status == ShootingStatus::Converged; }
 };
 
@@ -187,11 +188,13 @@ ShootingResult<X> solve_from_starts(const typename SchemeFor<X>::BVP& bvp,
             format_residual(out.residual_norm) + " x tolerance" + rank_note +
             ": try multiple shooting with more segments, a smaller h, or a better guess";
     } else if (below_floor) {
+      out.stalled_at_floor = true;
       msg = "the residual stalled at " + format_residual(out.residual_norm) + " x tolerance" + rank_note +
             ": the tolerance is below the roundoff floor of this scheme at h = " + format_residual(bvp.h()) +
             " (estimated at " + format_residual(system.floor_ratio()) + " x tolerance on the worst row); " +
             A::floor_remedy;
     } else if (out.residual_norm < 1e3 && so.residual_history.front() > 1e3 * out.residual_norm) {
+      out.stalled_at_floor = true;
       int longest = 0;
       for (int i = 0; i < S; ++i) longest = std::max(longest, starts[i + 1] - starts[i]);
       msg = "the residual stalled at " + format_residual(out.residual_norm) + " x tolerance after a " +
@@ -239,7 +242,10 @@ ShootingResult<X> solve_bvp_with(const typename SchemeFor<X>::BVP& bvp, const ty
   out.propagated_starts = sweep_first;
   // Auto: when the guess's interior states did not lead to a solution, the forward sweep's may
   // (a stiff potential: the guess is far from the dynamics; an unstable flow: the sweep is not).
-  if (S > 1 && opt.segment_starts == SegmentStarts::Auto && out.status == ShootingStatus::NotConverged) {
+  // Not after a stall at the flows' roundoff floor (stalled_at_floor): that floor belongs to the
+  // grid and the segments, not to the starts (the beanie at N = 10^6: ~17 minutes per attempt).
+  if (S > 1 && opt.segment_starts == SegmentStarts::Auto && out.status == ShootingStatus::NotConverged &&
+      !out.stalled_at_floor) {
     ShootingResult<X> swept = detail::solve_from_starts<X>(bvp, detail::forward_sweep<X>(bvp, refs, starts, opt.step), starts, opt);
     swept.propagated_starts = true;
     swept.iterations += out.iterations;

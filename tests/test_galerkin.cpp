@@ -304,22 +304,26 @@ TEST(GalerkinFlow, TooFewGaussPointsMakeTheStepSingular) {
   EXPECT_TRUE(first_failure(Galerkin<ElectronModel, 3, 2>{}).ok());
 }
 
-TEST(GalerkinShooting, JacobianMatchesFiniteDifferences) {
+// The shooting Jacobian (flows' sensitivities, continuity, and the boundary rows from the end
+// intervals' Hessians, galerkin_end_rows) against central differences.
+template <int S>
+void check_shooting_jacobian() {
+  using Sch = BeanieGalerkin<S>;
   BeanieModel model;
   model.par = {1.0, 1.0, 0.5, 1.0};
   BeanieBoundary s, e;
   s.psi = 0.1, s.psi_dot = 0.3, s.theta = 0.2, s.x = 0.5, s.y = -0.3, s.Omega1 = 0.5, s.Omega2 = 0.2;
   e.psi = 1.0, e.psi_dot = -0.2, e.theta = 1.4, e.x = 1.0;  // x(T) fixed too: group natural + fixed mix
   const int N = 30;
-  const auto bvp = beanie_galerkin_bvp<3>(model, 1.5, N, s, e);
-  const auto guess = beanie_galerkin_guess<3>(bvp, s, e);
-  for (int S : {1, 3}) {
+  const auto bvp = beanie_galerkin_bvp<S>(model, 1.5, N, s, e);
+  const auto guess = beanie_galerkin_guess<S>(bvp, s, e);
+  for (int segs : {1, 3}) {
     std::vector<int> starts;
-    for (int i = 0; i <= S; ++i) starts.push_back((N - 1) * i / S);
-    const auto refs = GalerkinScheme<BG>::states(bvp, guess, std::vector<int>(starts.begin(), starts.end() - 1));
+    for (int i = 0; i <= segs; ++i) starts.push_back((N - 1) * i / segs);
+    const auto refs = GalerkinScheme<Sch>::states(bvp, guess, std::vector<int>(starts.begin(), starts.end() - 1));
     NewtonOptions tight;
     tight.step_tolerance = 1e-13;
-    detail::ShootingSystem<BG> sys(bvp, refs, starts, tight, 1);
+    detail::ShootingSystem<Sch> sys(bvp, refs, starts, tight, 1);
     std::mt19937 rng(5);
     std::normal_distribution<double> n01;
     Eigen::VectorXd x(sys.size());
@@ -341,10 +345,13 @@ TEST(GalerkinShooting, JacobianMatchesFiniteDifferences) {
       const Eigen::VectorXd fd = (4 * central(eps) - central(2 * eps)) / 3;
       worst = std::max(worst, (J.col(j) - fd).lpNorm<Eigen::Infinity>() / std::max(1.0, fd.lpNorm<Eigen::Infinity>()));
     }
-    std::printf("segments %d: %d unknowns, max relative Jacobian error %.2e\n", S, sys.size(), worst);
+    std::printf("degree %d, segments %d: %d unknowns, max relative Jacobian error %.2e\n", S, segs, sys.size(), worst);
     EXPECT_LT(worst, 1e-6);
   }
 }
+
+TEST(GalerkinShooting, JacobianMatchesFiniteDifferences) { check_shooting_jacobian<3>(); }
+TEST(GalerkinShooting, JacobianWithBubblesMatchesFiniteDifferences) { check_shooting_jacobian<4>(); }
 
 TEST(GalerkinShooting, NoRoundoffFloorOnFineGrids) {
   // Order 6 on increments: the error keeps falling to ~1e-13 and stays near roundoff on grids

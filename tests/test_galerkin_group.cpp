@@ -1,7 +1,10 @@
 // Galerkin steps with a group from each interval's gradient and Hessian (core/galerkin_group.hpp):
 // the second-order scalar Hess against nested duals, and the step's equations and derivatives
-// (with the group's bracket terms) against the nested-dual evaluation at generic points.
+// (with the group's bracket terms) against the nested-dual evaluation at generic points, and the
+// end nodes' rows from the action (core/galerkin_end_rows.hpp) likewise.
+#include <lpshoot/core/galerkin_end_rows.hpp>
 #include <lpshoot/core/hessian_scalar.hpp>
+#include <lpshoot/problems/electron_bvp.hpp>
 
 #include "beanie_galerkin_start.hpp"
 
@@ -124,3 +127,69 @@ TEST(GalerkinGroupStep, QuarticWithBubblesMatchesNestedDuals) { expect_same_step
 TEST(GalerkinGroupStep, LargeStepMatchesNestedDuals) { expect_same_step<3>(0.5); }
 
 }  // namespace
+
+namespace {
+
+// galerkin_end_rows (natural conditions and the first interval's own rows, with derivatives in
+// the interval's tangent coordinates) against nested duals over the whole tangent: node_residual
+// and aux_residual of the interval seeded in every coordinate, multipliers included.
+template <class Sch>
+double end_rows_difference(const typename Sch::Model& model, const Interval<Sch, double>& iv, double h) {
+  constexpr int nz = Sch::unknowns, ns = Sch::state, nv = Sch::variation, nm = multiplier_count<Sch>;
+  using TD = Dual<double, ns>;
+  Interval<Sch, TD> s = seeded_state<Sch, TD>(iv, h, 0);
+  for (int c = 0; c < nm; ++c) s.w(Sch::multipliers(0) + c) = TD::variable(iv.w(Sch::multipliers(0) + c), ns - nm + c);
+  double worst = 0;
+  for (bool initial : {true, false}) {
+    Vec<double, nz> R;
+    Eigen::Matrix<double, nz, ns> J;
+    const int rows = galerkin_end_rows<Sch>(model, iv, h, initial, R, J);
+    EXPECT_EQ(rows, initial ? nz : nv);
+    Vec<TD, nz> ref;
+    ref.template head<nv>() = initial ? node_residual<Sch, TD>(model, nullptr, &s, h) : node_residual<Sch, TD>(model, &s, nullptr, h);
+    if (initial) ref.template tail<Sch::aux>() = aux_residual<Sch, TD>(model, s, h);
+    double rs = 0, js = 0, dr = 0, dj = 0;
+    for (int i = 0; i < rows; ++i) {
+      rs = std::max(rs, std::abs(ref(i).v)), dr = std::max(dr, std::abs(ref(i).v - R(i)));
+      for (int c = 0; c < ns; ++c) js = std::max(js, std::abs(ref(i).d[c])), dj = std::max(dj, std::abs(ref(i).d[c] - J(i, c)));
+    }
+    if (rows < nz) {
+      EXPECT_EQ(J.bottomRows(nz - rows).cwiseAbs().maxCoeff(), 0.0);
+    }
+    worst = std::max({worst, dr / rs, dj / js});
+  }
+  return worst;
+}
+
+template <int S>
+void expect_same_beanie_end_rows(double h) {
+  using Sch = BeanieGalerkin<S>;
+  BeanieModel model;
+  model.par = {1.0, 1.0, 0.5, 1.0};
+  std::mt19937 rng(17);
+  double worst = 0;
+  for (int trial = 0; trial < 5; ++trial) worst = std::max(worst, end_rows_difference<Sch>(model, generic_interval<Sch>(model, rng), h));
+  std::printf("beanie degree %d, h = %g: end rows from the interval's Hessian vs nested duals, max relative difference %.2e\n",
+              S, h, worst);
+  EXPECT_LT(worst, 1e-12);
+}
+
+}  // namespace
+
+TEST(GalerkinEndRows, BeanieCubicMatchesNestedDuals) { expect_same_beanie_end_rows<3>(0.05); }
+TEST(GalerkinEndRows, BeanieQuarticWithBubblesMatchesNestedDuals) { expect_same_beanie_end_rows<4>(0.5); }
+TEST(GalerkinEndRows, ElectronWithBubblesMatchesNestedDuals) {  // no group: galerkin_flat.hpp's maps
+  using Sch = Galerkin<ElectronModel, 4, 3>;
+  const auto model = model_of(Electron{});
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> u(-1, 1);
+  double worst = 0;
+  for (int trial = 0; trial < 5; ++trial) {
+    Interval<Sch, double> iv;
+    for (int a = 0; a < Sch::r; ++a) iv.x(a) = u(rng), iv.v(a) = u(rng), iv.X2(a) = u(rng), iv.V1(a) = u(rng);
+    for (int a = 0; a < Sch::aux; ++a) iv.w(a) = u(rng);
+    worst = std::max(worst, end_rows_difference<Sch>(model, iv, 0.1));
+  }
+  std::printf("electron degree 4: end rows vs nested duals, max relative difference %.2e\n", worst);
+  EXPECT_LT(worst, 1e-12);
+}
