@@ -100,6 +100,8 @@ class GalerkinFlow {
     // map alone is off by δ(dz) |state - state_0|, δ(dz) ~ cond(J) u |dz|.
     ChordMatrix<nz> chord;
     ChordMatrix<nz>* const chord_used = seed || d > 0 ? &chord : nullptr;
+    NewtonOptions step_options = options_;  // chord-ended steps of a trajectory: polished (newton.hpp)
+    step_options.polish_chord = !seed && d > 0;
     StepCarry<Sch> carry;  // interval derivatives shared by consecutive steps
     StepCarry<Sch>* const carry_used = &carry;
     Eigen::Matrix<double, nz, ns> dz;
@@ -122,7 +124,7 @@ class GalerkinFlow {
       }
       const bool extrapolated = d > 0 && k >= 2;
       if (extrapolated) predicted = extrapolate(k >= 3 ? &earlier : nullptr, before, s);
-      if (!rep.add(solve_galerkin_step<Sch>(model_, h_, s, first_node + k, options_, z, mapped ? &chord : chord_used,
+      if (!rep.add(solve_galerkin_step<Sch>(model_, h_, s, first_node + k, step_options, z, mapped ? &chord : chord_used,
                                             carry_used, mapped || extrapolated ? &predicted : nullptr, mapped)))
         return out;
       if (seed || affine_) {

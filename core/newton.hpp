@@ -42,6 +42,11 @@ struct NewtonOptions {
   // Problems whose step equations are affine with a constant matrix (core/degree.hpp) factor it
   // once per flow: the chord step is then the Newton step. False: every step evaluates its own.
   bool reuse_constant_matrix = true;
+  // A chord step that meets the tolerance leaves an error of ~ρ |dz| (ρ the chord's contraction),
+  // against ~|dz|² for a Newton step. With polish_chord chord corrections follow until one is
+  // within rounding (at most 3): set by flows whose steps end in chord steps and whose momentum
+  // map must hold to roundoff (galerkin_flow.hpp).
+  bool polish_chord = false;
 };
 
 enum class FlowStatus { Ok, NotConverged, Singular, NonFinite, InvalidInput };
@@ -193,6 +198,15 @@ StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian,
     const Vn scale = magnitude();
     correct(dz);
     if (affine || ((dz.cwiseAbs().array() - opt.step_tolerance * (1.0 + scale.array())) <= 0.0).all()) {
+      // Polish: chord corrections until one is within rounding (16 u relative; at most 3).
+      for (int p = 0; p < 3 && opt.polish_chord && !refresh && !affine; ++p) {
+        residual(F);
+        if (!all_finite(F.data(), n)) return fail(StepStatus::NonFinite, "the step equations evaluated to a non-finite number");
+        const Vn fine = lu.solve(-F);
+        const Vn fine_scale = magnitude();
+        correct(fine);
+        if (((fine.cwiseAbs().array() - 16 * eps * (1.0 + fine_scale.array())) <= 0.0).all()) break;
+      }
       rep.status = StepStatus::Converged;
       return rep;
     }
