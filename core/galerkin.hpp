@@ -84,8 +84,69 @@ GroupCurveEnds<Sch, T> group_curve_ends(const typename Sch::Model& model, const 
   e.zeta = G::log(iv.W);
   e.omega0 = iv.Om - connection_velocity(model, iv.x, iv.v);
   const Vec<T, Sch::d> end_velocity = iv.Om_end(h) - connection_velocity(model, iv.x_end(h), iv.v_end(h));
-  e.omega1 = right_jacobian_inverse<G, T>(e.zeta) * end_velocity;
+  e.omega1 = right_jacobian_inverse_times<G, T>(e.zeta, end_velocity);
   return e;
+}
+
+namespace detail {
+// x has no derivative part (every level's directions zero).
+inline bool derivative_free(double) { return true; }
+template <class T, int N>
+bool derivative_free(const Dual<T, N>& x) {
+  if (!derivative_free(x.v)) return false;
+  for (const T& e : x.d)
+    if (value(e) != 0.0 || !derivative_free(e)) return false;
+  return true;
+}
+}  // namespace detail
+
+// 𝒜(p) p' and its time derivative D𝒜(p)[p'] p' + 𝒜(p) p'', in Dual<T, 1> (first order in time).
+template <class C, class T>
+void connection_jet_generic(const C& model, const Vec<T, C::shape_dim>& p, const Vec<T, C::shape_dim>& dp,
+                            const Vec<T, C::shape_dim>& ddp, Vec<T, C::Group::dim>& cv, Vec<T, C::Group::dim>& dcv) {
+  using T1 = Dual<T, 1>;
+  Vec<T1, C::shape_dim> pT, dpT;
+  for (int a = 0; a < C::shape_dim; ++a) {
+    pT(a).v = p(a);
+    pT(a).d[0] = dp(a);
+    dpT(a).v = dp(a);
+    dpT(a).d[0] = ddp(a);
+  }
+  const Vec<T1, C::Group::dim> c = connection_velocity(model, pT, dpT);
+  for (int i = 0; i < C::Group::dim; ++i) cv(i) = c(i).v, dcv(i) = c(i).d[0];
+}
+
+// The same, cheaper when 𝒜 is constant to the order T's derivatives need: when 𝒜's derivatives at
+// p to order K + 1 vanish (K = T's derivative order; checked in double duals), 𝒜 is a double
+// matrix, cv = 𝒜 p' and dcv = 𝒜 p'' (the beanie's 𝒜 = (0, 0, c)). Otherwise the generic route.
+template <class C, class T>
+void connection_jet(const C& model, const Vec<T, C::shape_dim>& p, const Vec<T, C::shape_dim>& dp,
+                    const Vec<T, C::shape_dim>& ddp, Vec<T, C::Group::dim>& cv, Vec<T, C::Group::dim>& dcv) {
+  constexpr int r = C::shape_dim, d = C::Group::dim;
+  constexpr int K = derivative_order<T>::value;
+  if constexpr (K <= 2) {
+    using P = Dual<Dual<Dual<double, r>, r>, r>;
+    Vec<P, r> pp;
+    for (int a = 0; a < r; ++a)
+      pp(a) = P::variable(Dual<Dual<double, r>, r>::variable(Dual<double, r>::variable(value(p(a)), a), a), a);
+    const Eigen::Matrix<P, d, r> A = model.template connection_form<P>(pp);
+    bool constant = true;
+    for (int i = 0; i < d && constant; ++i)
+      for (int k = 0; k < r && constant; ++k) constant = detail::derivative_free(A(i, k));
+    if (constant) {
+      for (int i = 0; i < d; ++i) {
+        cv(i) = T(0.0), dcv(i) = T(0.0);
+        for (int k = 0; k < r; ++k) {
+          const double a = value(A(i, k));
+          if (a == 0.0) continue;
+          add_scaled(cv(i), a, dp(k));
+          add_scaled(dcv(i), a, ddp(k));
+        }
+      }
+      return;
+    }
+  }
+  connection_jet_generic(model, p, dp, ddp, cv, dcv);
 }
 
 // The jet q = (p, p', p'', Ω, Ω') at Gauss point i.
@@ -99,44 +160,44 @@ Jet<typename Sch::Model, T> jet_at(const typename Sch::Model& model, const Inter
   const double tau = GalerkinTable<Sch::degree, Sch::gauss>::get().c[i];
   // Shape: the k-th time derivative of h²(X2 H01 + V1 H11 + Σ a_j β_j) is h^(2-k) times this.
   auto shape_part = [&](int k) {
-    Vec<T, r> s = B[2][k] * iv.X2 + B[3][k] * iv.V1;
-    if constexpr (Sch::bubbles > 0)
-      for (int j = 0; j < Sch::bubbles; ++j) s += B[4 + j][k] * iv.w.template segment<r>(Sch::shape_bubble(j));
+    Vec<T, r> s;
+    for (int a = 0; a < r; ++a) {
+      s(a) = B[2][k] * iv.X2(a);
+      add_scaled(s(a), B[3][k], iv.V1(a));
+      for (int j = 0; j < Sch::bubbles; ++j) add_scaled(s(a), B[4 + j][k], iv.w(Sch::shape_bubble(j) + a));
+    }
     return s;
   };
   Jet<C, T> q;
-  q.p = iv.x + (h * tau) * iv.v + (h * h) * shape_part(0);
-  q.dp = iv.v + h * shape_part(1);
+  q.p = shape_part(0);
+  q.dp = shape_part(1);
+  for (int a = 0; a < r; ++a) {
+    q.p(a) = q.p(a) * (h * h);
+    add_scaled(q.p(a), 1.0, iv.x(a));
+    add_scaled(q.p(a), h * tau, iv.v(a));
+    q.dp(a) = q.dp(a) * h;
+    add_scaled(q.dp(a), 1.0, iv.v(a));
+  }
   q.ddp = shape_part(2);
   if constexpr (d > 0) {
-    using TT = Taylor2<T>;
-    // ξ(t_i + s) to second order in s (time units): ξ, ξ_τ / h, ξ_ττ / (2 h²).
-    auto xi_part = [&](int k) {
-      Vec<T, d> s = (h * B[1][k]) * ends.omega0 + B[2][k] * ends.zeta + (h * B[3][k]) * ends.omega1;
-      if constexpr (Sch::bubbles > 0)
-        for (int j = 0; j < Sch::bubbles; ++j)
-          s += (h * h * B[4 + j][k]) * iv.w.template segment<d>(Sch::group_bubble(j));
+    // The time derivatives ξ^(k)(t_i), k = 0, 1, 2 (h^(-k) times the τ-derivatives).
+    auto xi_derivative = [&](int k) {
+      const double hk = k == 0 ? 1.0 : k == 1 ? 1.0 / h : 1.0 / (h * h);
+      Vec<T, d> s;
+      for (int a = 0; a < d; ++a) {
+        s(a) = (h * hk * B[1][k]) * ends.omega0(a);
+        add_scaled(s(a), hk * B[2][k], ends.zeta(a));
+        add_scaled(s(a), h * hk * B[3][k], ends.omega1(a));
+        for (int j = 0; j < Sch::bubbles; ++j) add_scaled(s(a), h * h * hk * B[4 + j][k], iv.w(Sch::group_bubble(j) + a));
+      }
       return s;
     };
-    const Vec<T, d> x0 = xi_part(0), x1 = xi_part(1), x2 = xi_part(2);
-    typename G::template Tangent<TT> xi;
-    for (int a = 0; a < d; ++a) xi(a) = TT(x0(a), x1(a) / h, x2(a) / (2 * h * h));
-    typename G::template Tangent<T> Omb, dOmb;
-    body_velocity_jet<G, T>(xi, Omb, dOmb);
-    q.Omega = Omb;
-    q.dOmega = dOmb;
-    if constexpr (detail::HasConnectionForm<C, TT>::value) {  // + 𝒜(p) p' and its time derivative
-      const Vec<T, r> dddp = shape_part(3) / h;
-      Vec<TT, r> pT, dpT;
-      for (int a = 0; a < r; ++a) {
-        pT(a) = TT(q.p(a), q.dp(a), 0.5 * q.ddp(a));
-        dpT(a) = TT(q.dp(a), q.ddp(a), 0.5 * dddp(a));
-      }
-      const Vec<TT, d> cv = connection_velocity(model, pT, dpT);
-      for (int a = 0; a < d; ++a) {
-        q.Omega(a) += cv(a).c0;
-        q.dOmega(a) += cv(a).c1;
-      }
+    body_velocity_jet<G, T>(xi_derivative(0), xi_derivative(1), xi_derivative(2), q.Omega, q.dOmega);
+    if constexpr (detail::HasConnectionForm<C, T>::value) {  // + 𝒜(p) p' and its time derivative
+      Vec<T, d> cv, dcv;
+      connection_jet(model, q.p, q.dp, q.ddp, cv, dcv);
+      q.Omega += cv;
+      q.dOmega += dcv;
     }
   }
   return q;

@@ -1,11 +1,13 @@
 // Velocities along group curves, for any of lpshoot's groups (used by the Galerkin schemes'
 // group part, METHOD.md §9 route (a): g(t) = g_n exp(ξ(t)) with ξ a polynomial in the algebra).
-//   body_velocity_jet: Ω and Ω' of exp(ξ(s)) at s = 0 from the Taylor series of ξ, through
+//   body_velocity_jet: Ω and Ω' of exp(ξ(s)) at s = 0 from ξ, ξ', ξ'' there: by the group's
+//     closed form (group_velocity.hpp), or generically through
 //     log(exp(ξ(0))^{-1} exp(ξ(s))) = Ω s + Ω' s^2 / 2 + O(s^3);
 //   right_jacobian: Jr(ζ) Y = d/dε log(exp(ζ)^{-1} exp(ζ + ε Y)), the body velocity of exp(ξ)
 //     at ξ = ζ per unit ξ'.
 #pragma once
 
+#include "group_velocity.hpp"
 #include "groups.hpp"
 #include "hessian_scalar.hpp"
 #include "scalar_tower.hpp"
@@ -15,18 +17,32 @@
 
 namespace lpshoot {
 
+// The generic route: the group's exp, compose and log in Taylor2<T>, ξ(s) = ξ0 + ξ1 s + ξ2 s²/2.
 template <class G, class T>
-void body_velocity_jet(const typename G::template Tangent<Taylor2<T>>& xi, typename G::template Tangent<T>& Omega,
-                       typename G::template Tangent<T>& dOmega) {
+void body_velocity_jet_generic(const typename G::template Tangent<T>& xi0, const typename G::template Tangent<T>& xi1,
+                               const typename G::template Tangent<T>& xi2, typename G::template Tangent<T>& Omega,
+                               typename G::template Tangent<T>& dOmega) {
   using TT = Taylor2<T>;
-  typename G::template Tangent<T> xi0;
-  for (int a = 0; a < G::dim; ++a) xi0(a) = xi(a).c0;
+  typename G::template Tangent<TT> xi;
+  for (int a = 0; a < G::dim; ++a) xi(a) = TT(xi0(a), xi1(a), 0.5 * xi2(a));
   const auto start_inverse = G::template cast<TT>(G::inverse(G::template exp<T>(xi0)));
   const typename G::template Tangent<TT> rel = G::log(G::compose(start_inverse, G::template exp<TT>(xi)));
   for (int a = 0; a < G::dim; ++a) {
     Omega(a) = rel(a).c1;
     dOmega(a) = 2.0 * rel(a).c2;
   }
+}
+
+// Ω and Ω' of exp(ξ(s)) at s = 0 from ξ, ξ', ξ'' there: by the group's closed form where it has
+// one (group_velocity.hpp), else generically.
+template <class G, class T>
+void body_velocity_jet(const typename G::template Tangent<T>& xi0, const typename G::template Tangent<T>& xi1,
+                       const typename G::template Tangent<T>& xi2, typename G::template Tangent<T>& Omega,
+                       typename G::template Tangent<T>& dOmega) {
+  if constexpr (GroupVelocity<G>::closed_form)
+    GroupVelocity<G>::template jet<T>(xi0, xi1, xi2, Omega, dOmega);
+  else
+    body_velocity_jet_generic<G, T>(xi0, xi1, xi2, Omega, dOmega);
 }
 
 // x = A^{-1} b for a small square A in any scalar (Gaussian elimination, partial pivoting on the
@@ -117,6 +133,16 @@ Eigen::Matrix<T, G::dim, G::dim> right_jacobian_inverse(const typename G::templa
       }
     return out;
   }
+}
+
+// Jr(ζ)^{-1} y: by the group's closed form where it has one (group_velocity.hpp).
+template <class G, class T>
+typename G::template Tangent<T> right_jacobian_inverse_times(const typename G::template Tangent<T>& zeta,
+                                                             const typename G::template Tangent<T>& y) {
+  if constexpr (GroupVelocity<G>::closed_form)
+    return GroupVelocity<G>::template right_jacobian_inverse_times<T>(zeta, y);
+  else
+    return right_jacobian_inverse<G, T>(zeta) * y;
 }
 
 }  // namespace lpshoot

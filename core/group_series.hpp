@@ -21,7 +21,8 @@ constexpr double series_coefficient(int j, int shift) {
   return ((j % 2 == 0) ? 1.0 : -1.0) / fact;
 }
 
-// sum_j (-1)^j w^(2j) / (2j + 1 + shift)!  for shift = 0 (sinc) and 1 (cosc / w), by Horner.
+// sum_j (-1)^j w^(2j) / (2j + 1 + shift)!  for shift = 0 (sinc), 1 (cosc / w) and 2
+// ((w - sin w) / w^3), by Horner.
 template <class T>
 T alternating_series(const T& w, int shift) {
   static constexpr double c0[10] = {
@@ -34,7 +35,12 @@ T alternating_series(const T& w, int shift) {
       series_coefficient(3, 1), series_coefficient(4, 1), series_coefficient(5, 1),
       series_coefficient(6, 1), series_coefficient(7, 1), series_coefficient(8, 1),
       series_coefficient(9, 1)};
-  const double* c = shift == 0 ? c0 : c1;
+  static constexpr double c2[10] = {
+      series_coefficient(0, 2), series_coefficient(1, 2), series_coefficient(2, 2),
+      series_coefficient(3, 2), series_coefficient(4, 2), series_coefficient(5, 2),
+      series_coefficient(6, 2), series_coefficient(7, 2), series_coefficient(8, 2),
+      series_coefficient(9, 2)};
+  const double* c = shift == 0 ? c0 : shift == 1 ? c1 : c2;
   // Terms kept so that the first omitted one, and its first four derivatives, are below 1e-17
   // relative (nested duals carry second derivatives, and a Taylor2 of them two more): at w = 0
   // three terms are exact to the fourth derivative.

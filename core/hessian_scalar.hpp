@@ -191,6 +191,13 @@ bool isfinite(const Hess<N>& a) {
 }
 
 template <int N>
+void add_scaled(Hess<N>& acc, double c, const Hess<N>& x) {
+  acc.v += c * x.v;
+  for (int i = 0; i < N; ++i) acc.g[i] += c * x.g[i];
+  for (int k = 0; k < Hess<N>::packed; ++k) acc.H[k] += c * x.H[k];
+}
+
+template <int N>
 struct derivative_order<Hess<N>> : std::integral_constant<int, 2> {};
 
 // detail::lift (scalar_tower.hpp) for Hess; in this namespace so that argument-dependent lookup

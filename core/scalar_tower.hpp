@@ -108,6 +108,18 @@ Poly<K> cos(const Poly<K>& x) {
   return periodic_series(x, {c, -s, -c, s});
 }
 
+// acc += c x (in place where the type allows: hessian_scalar.hpp).
+inline void add_scaled(double& acc, double c, double x) { acc += c * x; }
+template <class T>
+void add_scaled(T& acc, double c, const T& x) {
+  acc = acc + c * x;
+}
+template <class T, int N>
+void add_scaled(Dual<T, N>& acc, double c, const Dual<T, N>& x) {
+  add_scaled(acc.v, c, x.v);
+  for (int i = 0; i < N; ++i) add_scaled(acc.d[i], c, x.d[i]);
+}
+
 namespace detail {
 
 // f(x) for f given by its derivatives f[0..order] at value(x).

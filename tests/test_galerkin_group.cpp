@@ -1,7 +1,8 @@
 // Galerkin steps with a group from each interval's gradient and Hessian (core/galerkin_group.hpp):
 // the second-order scalar Hess against nested duals, and the step's equations and derivatives
 // (with the group's bracket terms) against the nested-dual evaluation at generic points, and the
-// end nodes' rows from the action (core/galerkin_end_rows.hpp) likewise.
+// end nodes' rows from the action (core/galerkin_end_rows.hpp) likewise; the connection
+// velocity's jet (core/galerkin.hpp) against finite differences and its generic route.
 #include <lpshoot/core/galerkin_end_rows.hpp>
 #include <lpshoot/core/hessian_scalar.hpp>
 #include <lpshoot/problems/electron_bvp.hpp>
@@ -192,4 +193,88 @@ TEST(GalerkinEndRows, ElectronWithBubblesMatchesNestedDuals) {  // no group: gal
   }
   std::printf("electron degree 4: end rows vs nested duals, max relative difference %.2e\n", worst);
   EXPECT_LT(worst, 1e-12);
+}
+
+namespace {
+// Connection forms for connection_jet (core/galerkin.hpp): one that varies with the shape, and
+// one whose derivatives vanish at p = 0 to second order but not to third.
+struct CurvedConnection {
+  using Group = SE2;
+  static constexpr int shape_dim = 2;
+  template <class T>
+  Eigen::Matrix<T, 3, 2> connection_form(const Vec<T, 2>& p) const {
+    using std::cos, std::sin;
+    Eigen::Matrix<T, 3, 2> A;
+    A << sin(p(0)), p(1) * p(1), T(0.3), cos(p(1)) * p(0), p(0) * p(0) * p(0), T(0.5);
+    return A;
+  }
+};
+struct CubicConnection {
+  using Group = SO2;
+  static constexpr int shape_dim = 1;
+  template <class T>
+  Eigen::Matrix<T, 1, 1> connection_form(const Vec<T, 1>& p) const {
+    return Eigen::Matrix<T, 1, 1>(p(0) * p(0) * p(0));
+  }
+};
+using CD = Dual<Dual<double, 2>, 2>;  // two directions, second derivatives
+CD cd_variable(double x, int i) { return CD::variable(Dual<double, 2>::variable(x, i), i); }
+
+// Every component (value, gradient, Hessian) of a and b agrees to tol.
+void expect_same_cd(const CD& a, const CD& b, double tol) {
+  EXPECT_NEAR(a.v.v, b.v.v, tol);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_NEAR(a.v.d[i], b.v.d[i], tol);
+    EXPECT_NEAR(a.d[i].v, b.d[i].v, tol);
+    for (int j = 0; j < 2; ++j) EXPECT_NEAR(a.d[i].d[j], b.d[i].d[j], tol);
+  }
+}
+}  // namespace
+
+TEST(ConnectionJet, TimeDerivativeMatchesFiniteDifferencesAlongACurve) {
+  // p(t) = p0 + p1 t + p2 t²/2 + p3 t³/6: cv(t) = 𝒜(p(t)) p'(t), dcv = cv'(0).
+  const CurvedConnection model;
+  const Vec<double, 2> p0(0.4, -0.8), p1(0.9, 0.3), p2(-0.5, 1.2), p3(0.7, -0.2);
+  auto cv_at = [&](double t) {
+    const Vec<double, 2> p = p0 + t * p1 + (0.5 * t * t) * p2 + (t * t * t / 6) * p3;
+    const Vec<double, 2> dp = p1 + t * p2 + (0.5 * t * t) * p3;
+    return Vec<double, 3>(model.connection_form<double>(p) * dp);
+  };
+  Vec<double, 3> cv, dcv;
+  connection_jet(model, p0, p1, p2, cv, dcv);
+  const double eps = 1e-5;
+  const Vec<double, 3> fd = (cv_at(eps) - cv_at(-eps)) / (2 * eps);
+  EXPECT_LT((cv - cv_at(0)).norm(), 1e-15);
+  EXPECT_LT((dcv - fd).norm(), 1e-9);
+  EXPECT_GT(dcv.norm(), 0.1);
+}
+
+TEST(ConnectionJet, ConstantFormsTakeTheDoublePathOnlyWhenExact) {
+  // In second-order duals the cubic's time derivative 3 p² p'² + p³ p'' has a non-zero second
+  // derivative at p = 0: its third derivative there is needed, so no constant shortcut. The
+  // beanie's constant form takes it and must give the generic route's numbers.
+  const CD x = cd_variable(0.0, 0), y = cd_variable(0.3, 1);
+  {
+    const CubicConnection model;
+    const Vec<CD, 1> p(x), dp(CD(1.5) + y), ddp(CD(-0.4) + x * y);
+    Vec<CD, 1> cv, dcv, cv_ref, dcv_ref;
+    connection_jet(model, p, dp, ddp, cv, dcv);
+    connection_jet_generic(model, p, dp, ddp, cv_ref, dcv_ref);
+    expect_same_cd(cv(0), cv_ref(0), 1e-15);
+    expect_same_cd(dcv(0), dcv_ref(0), 1e-15);
+    EXPECT_NEAR(dcv(0).d[0].d[0], 6.0 * (1.5 + 0.3) * (1.5 + 0.3), 1e-12);  // 3 · 2 δ² p'²
+  }
+  {
+    BeanieModel model;
+    model.par = {1.0, 1.0, 0.5, 1.0};
+    const Vec<CD, 1> p(CD(0.2) + x * y), dp(CD(0.7) + y * y), ddp(CD(-1.1) + x);
+    Vec<CD, 3> cv, dcv, cv_ref, dcv_ref;
+    connection_jet(model, p, dp, ddp, cv, dcv);
+    connection_jet_generic(model, p, dp, ddp, cv_ref, dcv_ref);
+    for (int a = 0; a < 3; ++a) {
+      expect_same_cd(cv(a), cv_ref(a), 1e-15);
+      expect_same_cd(dcv(a), dcv_ref(a), 1e-15);
+    }
+    EXPECT_NE(dcv(2).d[0].v, 0.0);
+  }
 }

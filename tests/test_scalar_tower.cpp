@@ -113,3 +113,53 @@ TEST(ScalarTower, LiftedRightJacobianInverseMatchesDirectEvaluation) {
       for (int j = 0; j < 3; ++j) expect_same(P(i, j), D1(i == j ? 1.0 : 0.0), 1e-13, "Jr^-1 Jr, first order", 1.0);
   }
 }
+
+namespace {
+// Ω and Ω' of exp(ξ0 + ξ1 s + ξ2 s²/2) and Jr(ξ0)^{-1} ξ1 by the closed forms and by the
+// generic routes, in second-order nested duals: the arguments depend on (x, y) with second
+// derivatives.
+template <class G>
+void expect_closed_form_velocity_matches_generic(double angle) {
+  static_assert(GroupVelocity<G>::closed_form);
+  constexpr int d = G::dim;
+  const D2 x = D2::variable(D1::variable(0.2, 0), 1), y = D2::variable(D1::variable(-0.1, 1), 0);
+  typename G::template Tangent<Taylor2<D2>> xi;
+  for (int a = 0; a < d; ++a) {
+    const D2 c0 = (a == d - 1 ? angle : 0.4 - 0.3 * a) + 0.5 * x - 0.25 * x * y + (0.1 + 0.05 * a) * y * y;
+    const D2 c1 = 0.7 - 0.6 * a + x * y - 0.3 * y + 0.2 * a * x * x;
+    const D2 c2 = -0.4 + 0.35 * a + 0.3 * x * x + 0.5 * y;
+    xi(a) = Taylor2<D2>(c0 - value(c0) + value(c0), c1, c2);
+  }
+  typename G::template Tangent<D2> x0, x1, x2, Om, dOm, Om_ref, dOm_ref;
+  for (int a = 0; a < d; ++a) x0(a) = xi(a).c0, x1(a) = xi(a).c1, x2(a) = 2.0 * xi(a).c2;
+  body_velocity_jet<G, D2>(x0, x1, x2, Om, dOm);
+  body_velocity_jet_generic<G, D2>(x0, x1, x2, Om_ref, dOm_ref);
+  for (int a = 0; a < d; ++a) {
+    expect_same(Om(a), Om_ref(a), 1e-13, "Omega", 1.0);
+    expect_same(dOm(a), dOm_ref(a), 1e-13, "dOmega", 1.0);
+  }
+  // Jr(ξ0)^{-1} ξ1 by the closed form against the inverted generic Jacobian.
+  const typename G::template Tangent<D2> inv = right_jacobian_inverse_times<G, D2>(x0, x1);
+  const typename G::template Tangent<D2> inv_ref = right_jacobian_inverse<G, D2>(x0) * x1;
+  for (int a = 0; a < d; ++a) expect_same(inv(a), inv_ref(a), 1e-13, "Jr^-1 y", 1.0);
+  // And in double.
+  typename G::template Tangent<double> y0, y1, y2, O, dO, O_ref, dO_ref;
+  for (int a = 0; a < d; ++a) y0(a) = value(x0(a)), y1(a) = value(x1(a)), y2(a) = value(x2(a));
+  body_velocity_jet<G, double>(y0, y1, y2, O, dO);
+  body_velocity_jet_generic<G, double>(y0, y1, y2, O_ref, dO_ref);
+  EXPECT_LT((O - O_ref).norm(), 1e-14 * (1 + O_ref.norm()));
+  EXPECT_LT((dO - dO_ref).norm(), 1e-14 * (1 + dO_ref.norm()));
+}
+}  // namespace
+
+TEST(ScalarTower, ClosedFormBodyVelocityAndJacobianInverseMatchTheGroupsExpAndLog) {
+  // Every series regime of group_series.hpp and group_velocity.hpp (|w| < 0.5, < 1) and the
+  // closed forms; SE(2)'s translation part is the non-trivial one.
+  for (double angle : {0.0, 1e-9, 1e-5, 0.02, 0.3, 0.7, 0.99, 1.3, 2.5, -1.9}) {
+    SCOPED_TRACE(angle);
+    expect_closed_form_velocity_matches_generic<SE2>(angle);
+    expect_closed_form_velocity_matches_generic<SO2>(angle);
+    expect_closed_form_velocity_matches_generic<Rn<2>>(angle);
+    expect_closed_form_velocity_matches_generic<Product<SE2, SO2>>(angle);
+  }
+}

@@ -1,0 +1,207 @@
+// Closed forms of the body velocity along a group curve exp(ξ(s)), for the groups lpshoot
+// offers (used by group_jets.hpp's body_velocity_jet, METHOD.md §9 route (a)).
+//
+// With ξ(s) = ξ0 + ξ1 s + ξ2 s²/2, the body velocity Ω(s) = exp(ξ)^{-1} d/ds exp(ξ) = Jr(ξ) ξ'
+// and its derivative at s = 0 are
+//   Ω = Jr(ξ0) ξ1,  Ω' = DJr(ξ0)[ξ1] ξ1 + Jr(ξ0) ξ2.
+// The generic route runs the group's exp/log in Taylor arithmetic of the engine's scalar (nested
+// duals or Hess, up to 17 directions); these closed forms need a few scalar functions of one
+// angle, lifted by their derivatives (scalar_tower.hpp), and a few dozen products.
+//   R^n, SO(2): Ω = ξ1, Ω' = ξ2 (abelian, Jr = I).
+//   SE(2), ξ = (v, w) (group_se2.hpp's coordinates), J the rotation by π/2:
+//     exp(ξ) = (w, V(w) v), V = a1 I + a2 J, so with the rotation R(w) and A = R(-w) V(w),
+//     B = R(-w) V'(w):
+//       Ω_w = w1,  Ω_v = A v1 + w1 B v,
+//       Ω'_w = w2, Ω'_v = w1 A' v1 + A v2 + w2 B v + w1² B' v + w1 B v1,
+//     where A = a1 I - a2 J, B = b1 I + b2 J with a1 = sin w / w, a2 = (1 - cos w) / w,
+//     b1 = (w - sin w) / w², b2 = (1 - cos w) / w² (V ≅ (e^{iw} - 1)/(iw) as a complex number,
+//     A its conjugate, B = e^{-iw} V'(w)).
+//   Product: componentwise.
+// The same structure inverts Jr (right_jacobian_inverse_times, the Galerkin curve's end slope):
+//   R^n, SO(2): Jr = I;  SE(2): Jr(ξ)(y_v, y_w) = (A y_v + y_w B v, y_w), so
+//   Jr(ξ)^{-1}(y_v, y_w) = (A^{-1}(y_v - y_w B v), y_w),  A^{-1} ≅ (w/2) cot(w/2) + i w/2.
+// Groups without a closed form keep the generic route (GroupVelocity<G>::closed_form false).
+#pragma once
+
+#include "group_series.hpp"
+#include "groups.hpp"
+
+#include <utility>
+
+namespace lpshoot {
+
+// Algebra coordinates of a dim-n group.
+template <class T, int n>
+using Algebra = Eigen::Matrix<T, n, 1>;
+
+template <class G>
+struct GroupVelocity {
+  static constexpr bool closed_form = false;
+};
+
+namespace detail {
+
+// f(x) and f'(x) for f written once generically (in double or Poly), lifted to x's type.
+template <class T, class F>
+std::pair<T, T> apply_univariate_with_slope(const T& x, F&& impl) {
+  if constexpr (std::is_same_v<T, double>) {
+    const Poly<1> p = impl(Poly<1>::variable(x));
+    return {p.a[0], p.a[1]};
+  } else {
+    constexpr int K = derivative_order<T>::value;
+    const Poly<K + 1> p = impl(Poly<K + 1>::variable(value(x)));
+    double f[K + 2];
+    double fact = 1.0;
+    for (int k = 0; k <= K + 1; ++k) {
+      if (k > 0) fact *= k;
+      f[k] = p.a[k] * fact;
+    }
+    return {lift(f, x), lift(f + 1, x)};
+  }
+}
+
+// (w - sin w) / w², by its series w Σ_j (-1)^j w^(2j) / (2j + 3)! for |w| < 1 (the closed form
+// loses ~6/w² ulps to cancellation).
+template <class T>
+T se2_b1_value(const T& w) {
+  using std::sin;
+  if (std::abs(value(w)) < 1.0) return w * alternating_series(w, 2);
+  return (w - sin(w)) / (w * w);
+}
+
+// (1 - cos w) / w² = cosc(w) / w, by its series for |w| < 0.5 and 2 sin²(w/2) / w² otherwise.
+template <class T>
+T se2_b2_value(const T& w) {
+  using std::sin;
+  if (std::abs(value(w)) < kSeriesRadius) return alternating_series(w, 1);
+  const T s = sin(w * 0.5);
+  return 2.0 * s * s / (w * w);
+}
+
+// (w/2) cot(w/2), by its series Σ_n c_n w^(2n) (from the Bernoulli numbers) for |w| < 0.5 and
+// the closed form otherwise (no cancellation there).
+template <class T>
+T se2_half_cot_value(const T& w) {
+  using std::cos;
+  using std::sin;
+  if (std::abs(value(w)) < kSeriesRadius) {
+    static constexpr double c[10] = {1.0,
+                                     -1.0 / 12.0,
+                                     -1.0 / 720.0,
+                                     -1.0 / 30240.0,
+                                     -1.0 / 1209600.0,
+                                     -1.0 / 47900160.0,
+                                     -691.0 / 1307674368000.0,
+                                     -1.0 / 74724249600.0,
+                                     -3617.0 / 10670622842880000.0,
+                                     -43867.0 / 5109094217170944000.0};
+    const T w2 = w * w;
+    T acc = T(c[9]);
+    for (int j = 8; j >= 0; --j) acc = acc * w2 + c[j];
+    return acc;
+  }
+  const T half = w * 0.5;
+  return half * cos(half) / sin(half);
+}
+
+// (α I + β J) x for J the rotation by π/2: (α x0 - β x1, β x0 + α x1).
+template <class T>
+Eigen::Matrix<T, 2, 1> complex_times(const T& alpha, const T& beta, const Eigen::Matrix<T, 2, 1>& x) {
+  return {alpha * x(0) - beta * x(1), beta * x(0) + alpha * x(1)};
+}
+
+}  // namespace detail
+
+template <int N>
+struct GroupVelocity<Rn<N>> {
+  static constexpr bool closed_form = true;
+  template <class T>
+  static void jet(const Algebra<T, N>&, const Algebra<T, N>& x1, const Algebra<T, N>& x2, Algebra<T, N>& Om, Algebra<T, N>& dOm) {
+    Om = x1;
+    dOm = x2;
+  }
+  template <class T>
+  static Algebra<T, N> right_jacobian_inverse_times(const Algebra<T, N>&, const Algebra<T, N>& y) {
+    return y;
+  }
+};
+
+template <>
+struct GroupVelocity<SO2> {
+  static constexpr bool closed_form = true;
+  template <class T>
+  static void jet(const Algebra<T, 1>&, const Algebra<T, 1>& x1, const Algebra<T, 1>& x2, Algebra<T, 1>& Om, Algebra<T, 1>& dOm) {
+    Om = x1;
+    dOm = x2;
+  }
+  template <class T>
+  static Algebra<T, 1> right_jacobian_inverse_times(const Algebra<T, 1>&, const Algebra<T, 1>& y) {
+    return y;
+  }
+};
+
+template <>
+struct GroupVelocity<SE2> {
+  static constexpr bool closed_form = true;
+  template <class T>
+  static void jet(const Algebra<T, 3>& x0, const Algebra<T, 3>& x1, const Algebra<T, 3>& x2, Algebra<T, 3>& Om, Algebra<T, 3>& dOm) {
+    using V2 = Eigen::Matrix<T, 2, 1>;
+    const T& w = x0(2);
+    const T &w1 = x1(2), &w2 = x2(2);
+    const V2 v = x0.template head<2>(), v1 = x1.template head<2>(), v2 = x2.template head<2>();
+    const auto [a1, da1] = detail::apply_univariate_with_slope(w, [](const auto& y) { return detail::sinc_value(y); });
+    const auto [a2, da2] = detail::apply_univariate_with_slope(w, [](const auto& y) { return detail::cosc_value(y); });
+    const auto [b1, db1] = detail::apply_univariate_with_slope(w, [](const auto& y) { return detail::se2_b1_value(y); });
+    const auto [b2, db2] = detail::apply_univariate_with_slope(w, [](const auto& y) { return detail::se2_b2_value(y); });
+    const V2 Bv = detail::complex_times(b1, b2, v);
+    const V2 Av1 = detail::complex_times(a1, T(-a2), v1);
+    Om.template head<2>() = Av1 + w1 * Bv;
+    Om(2) = w1;
+    const V2 dA_v1 = detail::complex_times(da1, T(-da2), v1);
+    const V2 dB_v = detail::complex_times(db1, db2, v);
+    const V2 B_v1 = detail::complex_times(b1, b2, v1);
+    const V2 A_v2 = detail::complex_times(a1, T(-a2), v2);
+    dOm.template head<2>() = A_v2 + w2 * Bv + w1 * (dA_v1 + B_v1 + w1 * dB_v);
+    dOm(2) = w2;
+  }
+  template <class T>
+  static Algebra<T, 3> right_jacobian_inverse_times(const Algebra<T, 3>& zeta, const Algebra<T, 3>& y) {
+    using V2 = Eigen::Matrix<T, 2, 1>;
+    const T& w = zeta(2);
+    const T b1 = detail::apply_univariate(w, [](const auto& u) { return detail::se2_b1_value(u); });
+    const T b2 = detail::apply_univariate(w, [](const auto& u) { return detail::se2_b2_value(u); });
+    const T alpha = detail::apply_univariate(w, [](const auto& u) { return detail::se2_half_cot_value(u); });
+    const V2 rhs = y.template head<2>() - y(2) * detail::complex_times(b1, b2, V2(zeta.template head<2>()));
+    Algebra<T, 3> x;
+    x.template head<2>() = detail::complex_times(alpha, T(0.5 * w), rhs);
+    x(2) = y(2);
+    return x;
+  }
+};
+
+template <class A, class B>
+struct GroupVelocity<Product<A, B>> {
+  static constexpr bool closed_form = GroupVelocity<A>::closed_form && GroupVelocity<B>::closed_form;
+  static constexpr int da = A::dim, db = B::dim;
+  template <class T>
+  static void jet(const Algebra<T, da + db>& x0, const Algebra<T, da + db>& x1, const Algebra<T, da + db>& x2,
+                  Algebra<T, da + db>& Om, Algebra<T, da + db>& dOm) {
+    Algebra<T, da> Oa, dOa;
+    Algebra<T, db> Ob, dOb;
+    GroupVelocity<A>::template jet<T>(x0.template head<da>(), x1.template head<da>(), x2.template head<da>(), Oa, dOa);
+    GroupVelocity<B>::template jet<T>(x0.template tail<db>(), x1.template tail<db>(), x2.template tail<db>(), Ob, dOb);
+    Om.template head<da>() = Oa;
+    Om.template tail<db>() = Ob;
+    dOm.template head<da>() = dOa;
+    dOm.template tail<db>() = dOb;
+  }
+  template <class T>
+  static Algebra<T, da + db> right_jacobian_inverse_times(const Algebra<T, da + db>& zeta, const Algebra<T, da + db>& y) {
+    Algebra<T, da + db> x;
+    x.template head<da>() = GroupVelocity<A>::template right_jacobian_inverse_times<T>(zeta.template head<da>(), y.template head<da>());
+    x.template tail<db>() = GroupVelocity<B>::template right_jacobian_inverse_times<T>(zeta.template tail<db>(), y.template tail<db>());
+    return x;
+  }
+};
+
+}  // namespace lpshoot
