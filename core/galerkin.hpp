@@ -16,6 +16,7 @@
 // Order 2S − 2 with Q = S − 1 points; fewer points leave the step matrix singular.
 #pragma once
 
+#include "connection_jet.hpp"
 #include "continuous.hpp"
 #include "group_jets.hpp"
 #include "hermite.hpp"
@@ -82,71 +83,10 @@ GroupCurveEnds<Sch, T> group_curve_ends(const typename Sch::Model& model, const 
   using G = typename Sch::Group;
   GroupCurveEnds<Sch, T> e;
   e.zeta = G::log(iv.W);
-  e.omega0 = iv.Om - connection_velocity(model, iv.x, iv.v);
-  const Vec<T, Sch::d> end_velocity = iv.Om_end(h) - connection_velocity(model, iv.x_end(h), iv.v_end(h));
+  e.omega0 = iv.Om - connection_velocity_of(model, iv.x, iv.v);
+  const Vec<T, Sch::d> end_velocity = iv.Om_end(h) - connection_velocity_of(model, iv.x_end(h), iv.v_end(h));
   e.omega1 = right_jacobian_inverse_times<G, T>(e.zeta, end_velocity);
   return e;
-}
-
-namespace detail {
-// x has no derivative part (every level's directions zero).
-inline bool derivative_free(double) { return true; }
-template <class T, int N>
-bool derivative_free(const Dual<T, N>& x) {
-  if (!derivative_free(x.v)) return false;
-  for (const T& e : x.d)
-    if (value(e) != 0.0 || !derivative_free(e)) return false;
-  return true;
-}
-}  // namespace detail
-
-// 𝒜(p) p' and its time derivative D𝒜(p)[p'] p' + 𝒜(p) p'', in Dual<T, 1> (first order in time).
-template <class C, class T>
-void connection_jet_generic(const C& model, const Vec<T, C::shape_dim>& p, const Vec<T, C::shape_dim>& dp,
-                            const Vec<T, C::shape_dim>& ddp, Vec<T, C::Group::dim>& cv, Vec<T, C::Group::dim>& dcv) {
-  using T1 = Dual<T, 1>;
-  Vec<T1, C::shape_dim> pT, dpT;
-  for (int a = 0; a < C::shape_dim; ++a) {
-    pT(a).v = p(a);
-    pT(a).d[0] = dp(a);
-    dpT(a).v = dp(a);
-    dpT(a).d[0] = ddp(a);
-  }
-  const Vec<T1, C::Group::dim> c = connection_velocity(model, pT, dpT);
-  for (int i = 0; i < C::Group::dim; ++i) cv(i) = c(i).v, dcv(i) = c(i).d[0];
-}
-
-// The same, cheaper when 𝒜 is constant to the order T's derivatives need: when 𝒜's derivatives at
-// p to order K + 1 vanish (K = T's derivative order; checked in double duals), 𝒜 is a double
-// matrix, cv = 𝒜 p' and dcv = 𝒜 p'' (the beanie's 𝒜 = (0, 0, c)). Otherwise the generic route.
-template <class C, class T>
-void connection_jet(const C& model, const Vec<T, C::shape_dim>& p, const Vec<T, C::shape_dim>& dp,
-                    const Vec<T, C::shape_dim>& ddp, Vec<T, C::Group::dim>& cv, Vec<T, C::Group::dim>& dcv) {
-  constexpr int r = C::shape_dim, d = C::Group::dim;
-  constexpr int K = derivative_order<T>::value;
-  if constexpr (K <= 2) {
-    using P = Dual<Dual<Dual<double, r>, r>, r>;
-    Vec<P, r> pp;
-    for (int a = 0; a < r; ++a)
-      pp(a) = P::variable(Dual<Dual<double, r>, r>::variable(Dual<double, r>::variable(value(p(a)), a), a), a);
-    const Eigen::Matrix<P, d, r> A = model.template connection_form<P>(pp);
-    bool constant = true;
-    for (int i = 0; i < d && constant; ++i)
-      for (int k = 0; k < r && constant; ++k) constant = detail::derivative_free(A(i, k));
-    if (constant) {
-      for (int i = 0; i < d; ++i) {
-        cv(i) = T(0.0), dcv(i) = T(0.0);
-        for (int k = 0; k < r; ++k) {
-          const double a = value(A(i, k));
-          if (a == 0.0) continue;
-          add_scaled(cv(i), a, dp(k));
-          add_scaled(dcv(i), a, ddp(k));
-        }
-      }
-      return;
-    }
-  }
-  connection_jet_generic(model, p, dp, ddp, cv, dcv);
 }
 
 // The jet q = (p, p', p'', Ω, Ω') at Gauss point i.

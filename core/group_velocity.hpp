@@ -110,6 +110,16 @@ Eigen::Matrix<T, 2, 1> complex_times(const T& alpha, const T& beta, const Eigen:
   return {alpha * x(0) - beta * x(1), beta * x(0) + alpha * x(1)};
 }
 
+// acc += (α I + s β J) x, s = ±1, products accumulated in place.
+template <class T>
+void add_complex_times(Eigen::Matrix<T, 2, 1>& acc, const T& alpha, double s, const T& beta,
+                       const Eigen::Matrix<T, 2, 1>& x) {
+  add_product(acc(0), 1.0, alpha, x(0));
+  add_product(acc(0), -s, beta, x(1));
+  add_product(acc(1), s, beta, x(0));
+  add_product(acc(1), 1.0, alpha, x(1));
+}
+
 }  // namespace detail
 
 template <int N>
@@ -153,15 +163,22 @@ struct GroupVelocity<SE2> {
     const auto [a2, da2] = detail::apply_univariate_with_slope(w, [](const auto& y) { return detail::cosc_value(y); });
     const auto [b1, db1] = detail::apply_univariate_with_slope(w, [](const auto& y) { return detail::se2_b1_value(y); });
     const auto [b2, db2] = detail::apply_univariate_with_slope(w, [](const auto& y) { return detail::se2_b2_value(y); });
-    const V2 Bv = detail::complex_times(b1, b2, v);
-    const V2 Av1 = detail::complex_times(a1, T(-a2), v1);
-    Om.template head<2>() = Av1 + w1 * Bv;
+    // Ω_v = A v1 + (w1 B) v;  Ω'_v = A v2 + (w1 (A' + B)) v1 + (w2 B + w1² B') v.
+    const T wb1 = w1 * b1, wb2 = w1 * b2;
+    const T wp1 = w1 * (da1 + b1), wp2 = w1 * (b2 - da2);
+    const T w1sq = w1 * w1;
+    T q1 = w2 * b1, q2 = w2 * b2;
+    add_product(q1, 1.0, w1sq, db1);
+    add_product(q2, 1.0, w1sq, db2);
+    V2 o = V2::Constant(T(0.0)), d = V2::Constant(T(0.0));
+    detail::add_complex_times(o, a1, -1.0, a2, v1);
+    detail::add_complex_times(o, wb1, 1.0, wb2, v);
+    detail::add_complex_times(d, a1, -1.0, a2, v2);
+    detail::add_complex_times(d, wp1, 1.0, wp2, v1);
+    detail::add_complex_times(d, q1, 1.0, q2, v);
+    Om.template head<2>() = o;
     Om(2) = w1;
-    const V2 dA_v1 = detail::complex_times(da1, T(-da2), v1);
-    const V2 dB_v = detail::complex_times(db1, db2, v);
-    const V2 B_v1 = detail::complex_times(b1, b2, v1);
-    const V2 A_v2 = detail::complex_times(a1, T(-a2), v2);
-    dOm.template head<2>() = A_v2 + w2 * Bv + w1 * (dA_v1 + B_v1 + w1 * dB_v);
+    dOm.template head<2>() = d;
     dOm(2) = w2;
   }
   template <class T>

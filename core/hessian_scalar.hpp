@@ -198,6 +198,18 @@ void add_scaled(Hess<N>& acc, double c, const Hess<N>& x) {
 }
 
 template <int N>
+void add_product(Hess<N>& acc, double c, const Hess<N>& a, const Hess<N>& b) {
+  const double cav = c * a.v, cbv = c * b.v;
+  int k = 0;
+  for (int i = 0; i < N; ++i) {
+    const double cai = c * a.g[i], cbi = c * b.g[i];
+    for (int j = i; j < N; ++j, ++k) acc.H[k] += cbv * a.H[k] + cav * b.H[k] + cai * b.g[j] + cbi * a.g[j];
+  }
+  for (int i = 0; i < N; ++i) acc.g[i] += cbv * a.g[i] + cav * b.g[i];
+  acc.v += cav * b.v;
+}
+
+template <int N>
 struct derivative_order<Hess<N>> : std::integral_constant<int, 2> {};
 
 // detail::lift (scalar_tower.hpp) for Hess; in this namespace so that argument-dependent lookup

@@ -120,6 +120,21 @@ void add_scaled(Dual<T, N>& acc, double c, const Dual<T, N>& x) {
   for (int i = 0; i < N; ++i) add_scaled(acc.d[i], c, x.d[i]);
 }
 
+// acc += c a b (in place where the type allows: no temporary product).
+inline void add_product(double& acc, double c, double a, double b) { acc += c * a * b; }
+template <class T>
+void add_product(T& acc, double c, const T& a, const T& b) {
+  acc = acc + c * (a * b);
+}
+template <class T, int N>
+void add_product(Dual<T, N>& acc, double c, const Dual<T, N>& a, const Dual<T, N>& b) {
+  for (int i = 0; i < N; ++i) {
+    add_product(acc.d[i], c, a.d[i], b.v);
+    add_product(acc.d[i], c, a.v, b.d[i]);
+  }
+  add_product(acc.v, c, a.v, b.v);
+}
+
 namespace detail {
 
 // f(x) for f given by its derivatives f[0..order] at value(x).
