@@ -312,6 +312,27 @@ Eigen::Matrix<double, Sch::aux - multiplier_count<Sch>, multiplier_count<Sch>> b
   return D;
 }
 
+// node_residual(nullptr, &right) and aux_residual(right) in one evaluation: the node's
+// perturbation (directions 0..nv-1) and the bubbles (nv..nv+nb-1) seeded together in one dual,
+// the multiplier rows read off the same pass's constraint values. One evaluation of the
+// group curve's jet instead of three.
+template <class Sch>
+void right_interval_rows(const typename Sch::Model& model, const Interval<Sch, double>& right, double h,
+                         Vec<double, Sch::variation>& E, Vec<double, Sch::aux>& R) {
+  constexpr int nv = Sch::variation, nm = multiplier_count<Sch>, nb = Sch::aux - nm;
+  using TI = Dual<double, nv + nb>;
+  Interval<Sch, TI> l, q;
+  perturb_node<Sch, double, TI>(nullptr, &right, h, l, q);
+  for (int a = 0; a < nb; ++a) q.w(a) = TI::variable(right.w(a), nv + a);
+  TI S;
+  Vec<TI, nm> C;
+  interval_parts(model, q, h, S, C);
+  for (int k = 0; k < nm; ++k) S = S + q.w(Sch::multipliers(0) + k) * C(k);
+  for (int i = 0; i < nv; ++i) E(i) = S.d[i] / h;
+  for (int i = 0; i < nb; ++i) R(i) = S.d[nv + i] / h;
+  for (int k = 0; k < nm; ++k) R(nb + k) = C(k).v / h;
+}
+
 // The node after an interval: (x, v, Ω) at its end, and the interval that starts there with
 // the given unknowns.
 template <class Sch, class T>

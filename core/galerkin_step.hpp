@@ -217,8 +217,11 @@ Vec<double, Sch::unknowns> galerkin_step_residual(const typename Sch::Model& mod
     if (right_gradient) *right_gradient = g;
   } else {
     (void)right_gradient;
-    F.template head<nv>() = fixed + node_residual<Sch, double>(model, nullptr, &right, h);
-    F.template tail<na>() = aux_residual<Sch, double>(model, right, h);
+    Vec<double, nv> E;
+    Vec<double, na> R;
+    right_interval_rows<Sch>(model, right, h, E, R);
+    F.template head<nv>() = fixed + E;
+    F.template tail<na>() = R;
   }
   return F;
 }

@@ -120,7 +120,7 @@ void add_scaled(Dual<T, N>& acc, double c, const Dual<T, N>& x) {
   for (int i = 0; i < N; ++i) add_scaled(acc.d[i], c, x.d[i]);
 }
 
-// acc += c a b (in place where the type allows: no temporary product).
+// acc += c a b (in place where the type allows: no temporary product; acc must not be a or b).
 inline void add_product(double& acc, double c, double a, double b) { acc += c * a * b; }
 template <class T>
 void add_product(T& acc, double c, const T& a, const T& b) {
@@ -133,6 +133,12 @@ void add_product(Dual<T, N>& acc, double c, const Dual<T, N>& a, const Dual<T, N
     add_product(acc.d[i], c, a.v, b.d[i]);
   }
   add_product(acc.v, c, a.v, b.v);
+}
+template <int N>
+void add_product(Dual<double, N>& acc, double c, const Dual<double, N>& a, const Dual<double, N>& b) {
+  const double ca = c * a.v, cb = c * b.v;
+  for (int i = 0; i < N; ++i) acc.d[i] += cb * a.d[i] + ca * b.d[i];
+  acc.v += ca * b.v;
 }
 
 namespace detail {

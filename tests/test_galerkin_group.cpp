@@ -103,6 +103,9 @@ void expect_same_step(double h) {
     evaluate_galerkin_step_group<Sch, nz>(model, h, state, z, &fixed, G2, K2, nullptr);
     worst = std::max({worst, (G1 - G2).cwiseAbs().maxCoeff() / G1.cwiseAbs().maxCoeff(),
                       (K1 - K2).cwiseAbs().maxCoeff() / K1.cwiseAbs().maxCoeff()});
+    // The residual alone (chord iterations: node, bubble and multiplier rows in one pass).
+    const Vec<double, nz> R = galerkin_step_residual<Sch>(model, h, state, z, fixed);
+    worst = std::max(worst, (G1 - R).cwiseAbs().maxCoeff() / G1.cwiseAbs().maxCoeff());
     // The bracket terms are really exercised: without them the η rows would differ.
     const Eigen::Matrix<double, Sch::d, Sch::d> B =
         bracket_form<SE2>(carry.interval.gradient.template segment<Sch::d>(Sch::W_off));
