@@ -159,7 +159,7 @@ void interval_parts(const typename Sch::Model& model, const Interval<Sch, T>& iv
   L0 = T(0.0);
   for (int i = 0; i < Sch::gauss; ++i) {
     const auto q = jet_at(model, iv, ends, i, h);
-    L0 = L0 + (h * tab.b[i]) * model.template lagrangian<T>(q);
+    add_scaled(L0, h * tab.b[i], model.template lagrangian<T>(q));
     if constexpr (m > 0) {
       const Vec<T, m> chi = model.template constraints<T>(q);
       for (int c = 0; c < m; ++c) C(i * m + c) = (h * tab.b[i]) * chi(c);

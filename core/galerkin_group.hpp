@@ -68,7 +68,7 @@ IntervalDerivatives<Sch> group_interval_derivatives(const typename Sch::Model& m
   out.hessian.setZero();
   for (int c = 0; c < nm; ++c) {
     const double lambda = iv.w(Sch::multipliers(0) + c);
-    if (lambda != 0.0) L0 = L0 + lambda * C(c);
+    if (lambda != 0.0) add_scaled(L0, lambda, C(c));
     out.gradient(ny + c) = C(c).v;
     for (int i = 0; i < ny; ++i) out.hessian(i, ny + c) = out.hessian(ny + c, i) = C(c).g[i];
   }
@@ -155,7 +155,7 @@ void evaluate_galerkin_step_group(const typename Sch::Model& model, double h, co
   const D dr = group_interval_derivatives<Sch>(model, right, h);
 
   const Eigen::Matrix<double, nz, ne> Ar = group_right_map<Sch>(h, z.W);  // A_l below
-  const Eigen::Matrix<double, d, d> A = G::Ad(G::inverse(z.W));  // Ad_{W_n^{-1}}
+  const Eigen::Matrix<double, d, d> At = -Ar.template block<d, d>(eta, Sch::W_off);  // Ad_{W_n^{-1}}ᵀ, A_r's η block
 
   const double inv_h = 1.0 / h;
   F.noalias() = inv_h * (Ar * dr.gradient);
@@ -163,7 +163,7 @@ void evaluate_galerkin_step_group(const typename Sch::Model& model, double h, co
   // The unknowns are interval n's coordinates from X2 on (ζ as δ); the group's term (file comment).
   J.template leftCols<nz>() = ArH.template rightCols<nz>();
   const Eigen::Matrix<double, d, d> Br = bracket_form<G>(dr.gradient.template segment<d>(Sch::W_off));
-  J.template block<d, d>(eta, Sch::W_off - Sch::node) -= 0.5 * (A.transpose() * Br);
+  J.template block<d, d>(eta, Sch::W_off - Sch::node) -= 0.5 * (At * Br);
 
   if (fixed && !state_cols) {
     F.template head<nv>() += *fixed;
