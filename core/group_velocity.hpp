@@ -30,10 +30,6 @@
 
 namespace lpshoot {
 
-// Algebra coordinates of a dim-n group.
-template <class T, int n>
-using Algebra = Eigen::Matrix<T, n, 1>;
-
 template <class G>
 struct GroupVelocity {
   static constexpr bool closed_form = false;
@@ -126,12 +122,12 @@ template <int N>
 struct GroupVelocity<Rn<N>> {
   static constexpr bool closed_form = true;
   template <class T>
-  static void jet(const Algebra<T, N>&, const Algebra<T, N>& x1, const Algebra<T, N>& x2, Algebra<T, N>& Om, Algebra<T, N>& dOm) {
+  static void jet(const typename Rn<N>::template Tangent<T>&, const typename Rn<N>::template Tangent<T>& x1, const typename Rn<N>::template Tangent<T>& x2, typename Rn<N>::template Tangent<T>& Om, typename Rn<N>::template Tangent<T>& dOm) {
     Om = x1;
     dOm = x2;
   }
   template <class T>
-  static Algebra<T, N> right_jacobian_inverse_times(const Algebra<T, N>&, const Algebra<T, N>& y) {
+  static typename Rn<N>::template Tangent<T> right_jacobian_inverse_times(const typename Rn<N>::template Tangent<T>&, const typename Rn<N>::template Tangent<T>& y) {
     return y;
   }
 };
@@ -140,12 +136,12 @@ template <>
 struct GroupVelocity<SO2> {
   static constexpr bool closed_form = true;
   template <class T>
-  static void jet(const Algebra<T, 1>&, const Algebra<T, 1>& x1, const Algebra<T, 1>& x2, Algebra<T, 1>& Om, Algebra<T, 1>& dOm) {
+  static void jet(const SO2::Tangent<T>&, const SO2::Tangent<T>& x1, const SO2::Tangent<T>& x2, SO2::Tangent<T>& Om, SO2::Tangent<T>& dOm) {
     Om = x1;
     dOm = x2;
   }
   template <class T>
-  static Algebra<T, 1> right_jacobian_inverse_times(const Algebra<T, 1>&, const Algebra<T, 1>& y) {
+  static SO2::Tangent<T> right_jacobian_inverse_times(const SO2::Tangent<T>&, const SO2::Tangent<T>& y) {
     return y;
   }
 };
@@ -154,7 +150,7 @@ template <>
 struct GroupVelocity<SE2> {
   static constexpr bool closed_form = true;
   template <class T>
-  static void jet(const Algebra<T, 3>& x0, const Algebra<T, 3>& x1, const Algebra<T, 3>& x2, Algebra<T, 3>& Om, Algebra<T, 3>& dOm) {
+  static void jet(const SE2::Tangent<T>& x0, const SE2::Tangent<T>& x1, const SE2::Tangent<T>& x2, SE2::Tangent<T>& Om, SE2::Tangent<T>& dOm) {
     using V2 = Eigen::Matrix<T, 2, 1>;
     const T& w = x0(2);
     const T &w1 = x1(2), &w2 = x2(2);
@@ -182,14 +178,14 @@ struct GroupVelocity<SE2> {
     dOm(2) = w2;
   }
   template <class T>
-  static Algebra<T, 3> right_jacobian_inverse_times(const Algebra<T, 3>& zeta, const Algebra<T, 3>& y) {
+  static SE2::Tangent<T> right_jacobian_inverse_times(const SE2::Tangent<T>& zeta, const SE2::Tangent<T>& y) {
     using V2 = Eigen::Matrix<T, 2, 1>;
     const T& w = zeta(2);
     const T b1 = detail::apply_univariate(w, [](const auto& u) { return detail::se2_b1_value(u); });
     const T b2 = detail::apply_univariate(w, [](const auto& u) { return detail::se2_b2_value(u); });
     const T alpha = detail::apply_univariate(w, [](const auto& u) { return detail::se2_half_cot_value(u); });
     const V2 rhs = y.template head<2>() - y(2) * detail::complex_times(b1, b2, V2(zeta.template head<2>()));
-    Algebra<T, 3> x;
+    SE2::Tangent<T> x;
     x.template head<2>() = detail::complex_times(alpha, T(0.5 * w), rhs);
     x(2) = y(2);
     return x;
@@ -201,10 +197,10 @@ struct GroupVelocity<Product<A, B>> {
   static constexpr bool closed_form = GroupVelocity<A>::closed_form && GroupVelocity<B>::closed_form;
   static constexpr int da = A::dim, db = B::dim;
   template <class T>
-  static void jet(const Algebra<T, da + db>& x0, const Algebra<T, da + db>& x1, const Algebra<T, da + db>& x2,
-                  Algebra<T, da + db>& Om, Algebra<T, da + db>& dOm) {
-    Algebra<T, da> Oa, dOa;
-    Algebra<T, db> Ob, dOb;
+  static void jet(const typename Product<A, B>::template Tangent<T>& x0, const typename Product<A, B>::template Tangent<T>& x1, const typename Product<A, B>::template Tangent<T>& x2,
+                  typename Product<A, B>::template Tangent<T>& Om, typename Product<A, B>::template Tangent<T>& dOm) {
+    typename A::template Tangent<T> Oa, dOa;
+    typename B::template Tangent<T> Ob, dOb;
     GroupVelocity<A>::template jet<T>(x0.template head<da>(), x1.template head<da>(), x2.template head<da>(), Oa, dOa);
     GroupVelocity<B>::template jet<T>(x0.template tail<db>(), x1.template tail<db>(), x2.template tail<db>(), Ob, dOb);
     Om.template head<da>() = Oa;
@@ -213,8 +209,8 @@ struct GroupVelocity<Product<A, B>> {
     dOm.template tail<db>() = dOb;
   }
   template <class T>
-  static Algebra<T, da + db> right_jacobian_inverse_times(const Algebra<T, da + db>& zeta, const Algebra<T, da + db>& y) {
-    Algebra<T, da + db> x;
+  static typename Product<A, B>::template Tangent<T> right_jacobian_inverse_times(const typename Product<A, B>::template Tangent<T>& zeta, const typename Product<A, B>::template Tangent<T>& y) {
+    typename Product<A, B>::template Tangent<T> x;
     x.template head<da>() = GroupVelocity<A>::template right_jacobian_inverse_times<T>(zeta.template head<da>(), y.template head<da>());
     x.template tail<db>() = GroupVelocity<B>::template right_jacobian_inverse_times<T>(zeta.template tail<db>(), y.template tail<db>());
     return x;

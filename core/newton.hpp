@@ -13,6 +13,8 @@
 #include <Eigen/Core>
 #include <Eigen/LU>
 
+#include "one_norm_estimate.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -88,39 +90,16 @@ inline std::string format_number(double x) {
   return buf;
 }
 
-// ||J||_1 times an estimate of ||J^{-1}||_1 from the LU factors: Hager's method (Higham,
-// Algorithm 14.1, with LAPACK dlacn2's extra alternating vector, as dgecon): a lower bound, exact or within a small factor in practice, for a handful of
-// solves with J and J^T instead of n (the exact inverse's columns cost 6% of a beanie solve).
-// inf or NaN if J is singular (a zero pivot).
+// ||J||_1 times Hager's estimate of ||J^{-1}||_1 from the LU factors (one_norm_estimate.hpp): a
+// handful of solves instead of the inverse's n columns, which cost 6% of a beanie solve. inf or
+// NaN if J is singular (a zero pivot).
 template <class M, class LU>
 double condition_number_1(const M& J, const LU& lu) {
   constexpr int n = M::RowsAtCompileTime;
   using V = Eigen::Matrix<double, n, 1>;
-  const double norm = J.cwiseAbs().colwise().sum().maxCoeff();
-  V x = V::Constant(1.0 / n);
-  double estimate = 0;
-  int last = -1;
-  for (int iteration = 0; iteration < 5; ++iteration) {
-    const V y = lu.solve(x);
-    const double e = y.template lpNorm<1>();
-    if (!std::isfinite(e)) return norm * e;
-    if (iteration > 0 && e <= estimate) break;  // no progress (dlacn2's test)
-    estimate = e;
-    const V xi = y.unaryExpr([](double v) { return v >= 0 ? 1.0 : -1.0; });
-    const V z = lu.transpose().solve(xi);
-    int j = 0;
-    const double zmax = z.cwiseAbs().maxCoeff(&j);
-    if (zmax <= z.dot(x) || j == last) break;
-    x.setZero();
-    x(j) = 1.0;
-    last = j;
-  }
-  // dlacn2's safeguard against a bad start: x_i = ±(1 + i/(n-1)), |J^{-1} x|_1 · 2/(3n).
-  V alt;
-  for (int i = 0; i < n; ++i) alt(i) = (i % 2 == 0 ? 1.0 : -1.0) * (1.0 + (n > 1 ? double(i) / (n - 1) : 0.0));
-  const double e_alt = 2.0 * lu.solve(alt).template lpNorm<1>() / (3.0 * n);
-  if (!std::isfinite(e_alt)) return norm * e_alt;
-  return norm * std::max(estimate, e_alt);
+  const double inverse_norm = inverse_one_norm_estimate<V>([&](const V& b) -> V { return lu.solve(b); },
+                                                           [&](const V& b) -> V { return lu.transpose().solve(b); }, n);
+  return J.cwiseAbs().colwise().sum().maxCoeff() * inverse_norm;
 }
 
 inline bool all_finite(const double* x, int n) {

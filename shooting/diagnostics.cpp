@@ -4,6 +4,8 @@
 
 #include "band_lu.hpp"
 
+#include <lpshoot/core/one_norm_estimate.hpp>
+
 #include <Eigen/LU>
 #include <Eigen/QR>
 #include <Eigen/OrderingMethods>
@@ -71,29 +73,6 @@ RankDiagnosis diagnose_rank(Eigen::MatrixXd J, const std::vector<std::string>& n
   return out;
 }
 
-namespace {
-// Hager's estimate of |A^{-1}|_1 (Higham, Algorithm 14.1) from a factorization's solves with A
-// and A^T: a lower bound, exact or within a small factor in practice (as LAPACK's dgecon).
-template <class Solve, class SolveTransposed>
-double inverse_one_norm_estimate(const Solve& solve, const SolveTransposed& solve_transposed, int n) {
-  Eigen::VectorXd x = Eigen::VectorXd::Constant(n, 1.0 / n), y;
-  double estimate = 0;
-  int last = -1;
-  for (int iteration = 0; iteration < 5; ++iteration) {
-    y = solve(x);
-    estimate = y.lpNorm<1>();
-    const Eigen::VectorXd xi = y.unaryExpr([](double v) { return v >= 0 ? 1.0 : -1.0; });
-    const Eigen::VectorXd z = solve_transposed(xi);
-    int j = 0;
-    const double zmax = z.cwiseAbs().maxCoeff(&j);
-    if (zmax <= z.dot(x) || j == last) break;
-    x.setZero();
-    x(j) = 1;
-    last = j;
-  }
-  return estimate;
-}
-}  // namespace
 
 // Structured version, for a sparse J: the same equilibration and flush; the condition by
 // Hager's 1-norm estimate on a sparse LU; the rank by sparse QR, when the condition allows a
@@ -139,13 +118,13 @@ RankDiagnosis diagnose_rank(Eigen::SparseMatrix<double, Eigen::ColMajor, int> J,
   if (static_cast<double>(2 * kl + ku + 1) * n <= 4.0 * static_cast<double>(J.nonZeros()) + n) {
     const BandLU lu(J, kl, ku);
     if (lu.ok())
-      inverse_norm1 = inverse_one_norm_estimate([&](const Eigen::VectorXd& b) { return lu.solve(b); },
+      inverse_norm1 = inverse_one_norm_estimate<Eigen::VectorXd>([&](const Eigen::VectorXd& b) { return lu.solve(b); },
                                                 [&](const Eigen::VectorXd& b) { return lu.solve_transposed(b); }, n);
   } else {
     Eigen::SparseLU<Sparse, Eigen::COLAMDOrdering<int>> lu;
     lu.compute(J);
     if (lu.info() == Eigen::Success)
-      inverse_norm1 = inverse_one_norm_estimate([&](const Eigen::VectorXd& b) -> Eigen::VectorXd { return lu.solve(b); },
+      inverse_norm1 = inverse_one_norm_estimate<Eigen::VectorXd>([&](const Eigen::VectorXd& b) -> Eigen::VectorXd { return lu.solve(b); },
                                                 [&](const Eigen::VectorXd& b) -> Eigen::VectorXd { return lu.transpose().solve(b); }, n);
   }
   if (std::isfinite(norm1 * inverse_norm1)) out.condition = norm1 * inverse_norm1;
