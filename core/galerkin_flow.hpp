@@ -34,6 +34,14 @@ struct GalerkinTrajectory {
   }
 };
 
+// One solved step of a flow with sensitivities, kept as a guide for a later flow near it:
+// dz/d(state) and the step matrix ∂F/∂z at the solution, factored.
+template <class Sch>
+struct GalerkinStepMemo {
+  Eigen::Matrix<double, Sch::unknowns, Sch::state> dz;
+  ChordMatrix<Sch::unknowns> matrix;
+};
+
 template <class Sch>
 struct GalerkinFlowResult {
   GalerkinTrajectory<Sch> trajectory;  // the start interval and every completed step's
@@ -42,6 +50,8 @@ struct GalerkinFlowResult {
   // element at the last interval's base node, right tangent) when the seed had them.
   Eigen::MatrixXd sensitivity;
   typename Sch::Group::template Element<double> g_last;  // g at the last interval's base node
+  // Step k's memo at index k - 1, when the run recorded them (run's `record`, with a seed).
+  std::vector<GalerkinStepMemo<Sch>> memo;
 };
 
 template <class Sch>
@@ -61,9 +71,14 @@ class GalerkinFlow {
   // messages), g at its base node = g_start. `seed` (Sch::state or Sch::state + d rows) gives
   // the directions whose sensitivity is propagated. With keep = false only the last interval is
   // kept in the trajectory (memory O(1) in the steps).
+  // `guide`: an earlier run of the same steps from a nearby start, with its memo (`record`, with
+  // a seed, keeps one), e.g. the previous Newton iterate's in shooting. With a group, step k then
+  // starts from the guide's interval k moved to first order by the change of interval k-1
+  // (guide's dz), O(|change|²) off, with the guide's step matrix for its chord iterations.
   GalerkinFlowResult<Sch> run(const Interval<Sch, double>& start, int steps, const Eigen::MatrixXd* seed = nullptr,
                               const typename G::template Element<double>& g_start = G::template identity<double>(),
-                              int first_node = 0, bool keep = true) const {
+                              int first_node = 0, bool keep = true, const GalerkinFlowResult<Sch>* guide = nullptr,
+                              bool record = false) const {
     constexpr int r = Sch::r, d = Sch::d, ns = Sch::state, nz = Sch::unknowns;
     GalerkinFlowResult<Sch> out;
     out.trajectory.h = h_;
@@ -116,17 +131,42 @@ class GalerkinFlow {
     // (flat steps, cheap Jacobians) the last interval's: a fast-growing constrained flow
     // (tests/test_galerkin_flat.cpp) stalled at its noise from the extrapolation.
     Interval<Sch, double> before = start, earlier = start;  // intervals n-2 and n-3 (k >= 2, 3)
+    // A guide's prediction is taken when its first-order move is small, |move_i| <= 0.3 (1 + |z_i|)
+    // (a larger one is a poor linearization: beanie Galerkin 6 at N = 16, the second shooting
+    // iterate's moves take 98 Newton iterations guided, 86 extrapolated), and while it was the
+    // closer of the two predictions at the step before.
+    const bool guided = d > 0 && guide && guide->memo.size() == static_cast<size_t>(steps) &&
+                        guide->trajectory.intervals.size() == static_cast<size_t>(steps) + 1;
+    bool guide_closer = true;
+    if (record && seed) out.memo.reserve(steps);
     for (int k = 1; k <= steps; ++k) {
       Interval<Sch, double> z;
-      Vec<double, nz> predicted;
+      Vec<double, nz> predicted, from_guide;
       if constexpr (d == 0) {
         if (mapped) predicted = z_c + dz * flat_coordinates(s);
       }
       const bool extrapolated = d > 0 && k >= 2;
       if (extrapolated) predicted = extrapolate(k >= 3 ? &earlier : nullptr, before, s);
-      if (!rep.add(solve_galerkin_step<Sch>(model_, h_, s, first_node + k, step_options, z, mapped ? &chord : chord_used,
-                                            carry_used, mapped || extrapolated ? &predicted : nullptr, mapped)))
+      bool use_guide = false;
+      if (guided) {
+        const GalerkinStepMemo<Sch>& m = guide->memo[k - 1];
+        Interval<Sch, double> g = guide->trajectory.intervals[k];
+        const Vec<double, nz> move = m.dz * state_difference(s, guide->trajectory.intervals[k - 1], h_);
+        apply_galerkin_correction<Sch>(g, move, h_);
+        from_guide = unknowns_relative_to(g, s);
+        use_guide = guide_closer && (move.cwiseAbs().array() <= 0.3 * (1.0 + from_guide.cwiseAbs().array())).all();
+        if (use_guide) chord = m.matrix;
+      }
+      const Vec<double, nz>* start_from = use_guide ? &from_guide : mapped || extrapolated ? &predicted : nullptr;
+      if (!rep.add(solve_galerkin_step<Sch>(model_, h_, s, first_node + k, step_options, z,
+                                            mapped || use_guide ? &chord : chord_used, carry_used, start_from, mapped)))
         return out;
+      if (guided) {
+        const Vec<double, nz> solved = unknowns_relative_to(z, s);
+        const Vec<double, nz> other = extrapolated ? predicted : unknowns_relative_to(s, s);
+        guide_closer = (solved - from_guide).template lpNorm<Eigen::Infinity>() <=
+                       (solved - other).template lpNorm<Eigen::Infinity>();
+      }
       if (seed || affine_) {
         if (!dz_current) {
           dz = galerkin_step_sensitivity<Sch>(model_, h_, s, z, &chord, &condition, carry_used);
@@ -141,6 +181,7 @@ class GalerkinFlow {
                         singular_step_reason(condition, options_.max_condition);
           return out;
         }
+        if (record && seed) out.memo.push_back({dz, chord});
         if constexpr (d == 0) {
           if (affine_ && !mapped) {
             z_c = flat_coordinates(z).template tail<nz>() - dz * flat_coordinates(s);
@@ -204,6 +245,21 @@ class GalerkinFlow {
       p.template segment<d>(2 * r + d) = (a0 ? 2 * last - G::log(G::compose(G::inverse(a0->W), a.W)) : last) / h_;
     }
     p.template tail<Sch::aux>() = ext(c.w, a.w, b.w);
+    return p;
+  }
+
+  // Interval z's unknowns in solve_galerkin_step's predictor layout, ζ relative to interval s's W
+  // (W_z = W_s exp(h ζ)).
+  Vec<double, Sch::unknowns> unknowns_relative_to(const Interval<Sch, double>& z, const Interval<Sch, double>& s) const {
+    constexpr int r = Sch::r, d = Sch::d;
+    Vec<double, Sch::unknowns> p;
+    p.template segment<r>(0) = z.X2;
+    p.template segment<r>(r) = z.V1;
+    if constexpr (d > 0) {
+      p.template segment<d>(2 * r) = z.O1;
+      p.template segment<d>(2 * r + d) = G::log(G::compose(G::inverse(s.W), z.W)) / h_;
+    }
+    p.template tail<Sch::aux>() = z.w;
     return p;
   }
 

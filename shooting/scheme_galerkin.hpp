@@ -60,8 +60,12 @@ struct GalerkinScheme {
   static bool affine(const BVP& bvp, const NewtonOptions& step) {
     return Sch::d == 0 && step.reuse_constant_matrix && model_is_quadratic(bvp.model);
   }
-  static Run run(const Flow& flow, const State& start, int index, int steps, const Eigen::MatrixXd* seed) {
-    return flow.run(start.iv, steps, seed, start.g, index);
+  // A run with sensitivities can record a guide for the next run of its segment (GalerkinFlow::run):
+  // its memory per step (none without a group, whose steps do not use one).
+  static constexpr size_t guide_bytes_per_step = d > 0 ? sizeof(GalerkinStepMemo<Sch>) + sizeof(Interval<Sch, double>) : 0;
+  static Run run(const Flow& flow, const State& start, int index, int steps, const Eigen::MatrixXd* seed,
+                 const Run* guide = nullptr, bool record = false) {
+    return flow.run(start.iv, steps, seed, start.g, index, true, guide, record);
   }
   static State end_state(const Run& run) { return {run.trajectory.intervals.back(), run.g_last}; }
 

@@ -195,8 +195,15 @@ class ShootingSystem : public NonlinearSystem {
     // scheme a direction such as "move p_{2k-1} alone" is a (2k-1)-th difference of size
     // h^{-(2k-1)}, whose sensitivity would be recombined into O(1) entries afterwards by
     // cancellation, losing ~(2k-1) log10(1/h) digits twice.
+    // Each segment's flow is guided by its run at the last evaluation with sensitivities (the
+    // previous Newton iterate's, near this one), and a run with sensitivities records the next
+    // guide, within a memory budget (guides pay at coarse steps, where N is small).
+    const bool record = sensitivities && A::guide_bytes_per_step > 0 &&
+                        static_cast<double>(bvp_.N) * A::guide_bytes_per_step <= kGuideBudgetBytes;
+    const bool guided = static_cast<int>(guides_.size()) == S;
     auto work = [&](int i) {
-      runs[i] = A::run(flow_, starts[i], starts_[i], starts_[i + 1] - starts_[i], sensitivities ? &Jr[i] : nullptr);
+      runs[i] = A::run(flow_, starts[i], starts_[i], starts_[i + 1] - starts_[i], sensitivities ? &Jr[i] : nullptr,
+                       guided ? &guides_[i] : nullptr, record);
     };
     const int T = std::max(1, std::min(S, threads_ > 0 ? threads_ : static_cast<int>(std::thread::hardware_concurrency())));
     if (T == 1) {
@@ -236,6 +243,15 @@ class ShootingSystem : public NonlinearSystem {
         last_failure_ = "segment " + std::to_string(i) + ": " + runs[i].report.message;
         return false;
       }
+    if constexpr (A::guide_bytes_per_step > 0) {
+      if (record) {
+        guides_.resize(S);
+        for (int i = 0; i < S; ++i) {
+          guides_[i].trajectory.intervals = runs[i].trajectory.intervals;
+          guides_[i].memo = std::move(runs[i].memo);
+        }
+      }
+    }
     return true;
   }
 
@@ -344,6 +360,8 @@ class ShootingSystem : public NonlinearSystem {
   Eigen::VectorXd memo_x_, memo_F_;
   std::vector<typename A::Run> memo_runs_;
   std::vector<State> memo_starts_;
+  static constexpr double kGuideBudgetBytes = 64.0 * (1 << 20);
+  std::vector<typename A::Run> guides_;  // per segment, when recorded
   SparseJacobian last_J_;
   Eigen::VectorXd last_J_x_;
   bool memo_has_J_ = false, memo_ok_ = false;

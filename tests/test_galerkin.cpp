@@ -278,6 +278,63 @@ void check_reused_step_matrices() {
 TEST(GalerkinFlow, ReusedStepMatricesLandOnTheSameSolution) { check_reused_step_matrices<3>(); }
 TEST(GalerkinFlow, ReusedStepMatricesLandOnTheSameSolutionWithBubbles) { check_reused_step_matrices<4>(); }
 
+// A run guided by an earlier run from a nearby start (GalerkinFlow::run's `guide`: step k starts
+// from the guide's interval k moved by the guide's dz times the change of interval k-1, with the
+// guide's step matrix) lands on the same solution as an unguided run, with the same sensitivity.
+// Its predictions are O(ε²) off for a start moved by ε and its chord steps contract by O(ε), so a
+// step needs two iterations at ε = 1e-5 (1e-10, then below the step tolerance 1e-12) and three
+// at ε = 1e-3; without dz's term (O(ε) off) it would need three at ε = 1e-5. A start moved by
+// O(1) is not guided: the same Newton iterations as without a guide.
+template <int S>
+void check_guided_flow() {
+  using BG = BeanieGalerkin<S>;
+  BeanieModel model;
+  model.par = {1.0, 1.0, 0.5, 1.0};
+  const double h = 0.25;
+  const int steps = 7;
+  const auto start = beanie_interval_with_multipliers<S>(model, 2.0, 8);
+  const SE2::Element<double> g0{0.3, Eigen::Vector2d(0.5, -0.2)};
+  const GalerkinFlow<BG> flow(model, h);
+  constexpr int ns = BG::state, n = ns + BG::d;
+  const Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(n, n);
+  const auto guide = flow.run(start, steps, &seed, g0, 0, true, nullptr, true);
+  ASSERT_TRUE(guide.report.ok()) << guide.report.message;
+  ASSERT_EQ(guide.memo.size(), static_cast<size_t>(steps));
+  for (const double eps : {1e-5, 1e-3, 0.5}) {
+    Vec<double, ns> delta;
+    for (int i = 0; i < ns; ++i) delta(i) = eps * std::sin(2.0 + i);
+    const auto moved = retract<BG>(start, delta, h);
+    for (const Eigen::MatrixXd* sd : {&seed, static_cast<const Eigen::MatrixXd*>(nullptr)}) {
+      const auto plain = flow.run(moved, steps, sd, g0);
+      const auto guided = flow.run(moved, steps, sd, g0, 0, true, &guide);
+      ASSERT_TRUE(plain.report.ok()) << plain.report.message;
+      ASSERT_TRUE(guided.report.ok()) << guided.report.message;
+      double worst = 0;
+      for (int k = 0; k <= steps; ++k)
+        worst = std::max(worst, state_difference(guided.trajectory.intervals[k], plain.trajectory.intervals[k], h)
+                                    .template lpNorm<Eigen::Infinity>());
+      const double sens = sd ? (guided.sensitivity - plain.sensitivity).template lpNorm<Eigen::Infinity>() /
+                                   plain.sensitivity.template lpNorm<Eigen::Infinity>()
+                             : 0.0;
+      std::printf("degree %d, start moved by %g, %s: Newton iterations %d guided, %d plain; solutions differ by %.2e, "
+                  "sensitivities by %.2e\n",
+                  S, eps, sd ? "seeded" : "plain", guided.report.total_iterations, plain.report.total_iterations, worst,
+                  sens);
+      EXPECT_LT(worst, sd ? 1e-10 : 1e-13);  // chord-converged steps to the step tolerance; polished ones to roundoff
+      EXPECT_LT(sens, 1e-8);
+      if (eps < 0.1) {
+        EXPECT_LE(guided.report.total_iterations, (eps < 1e-4 ? 2 : 3) * steps);
+        EXPECT_LT(guided.report.total_iterations, plain.report.total_iterations);
+      } else {
+        EXPECT_EQ(guided.report.total_iterations, plain.report.total_iterations);
+      }
+    }
+  }
+}
+
+TEST(GalerkinFlow, GuidedRunsLandOnTheSameSolutionInFewerIterations) { check_guided_flow<3>(); }
+TEST(GalerkinFlow, GuidedRunsLandOnTheSameSolutionInFewerIterationsWithBubbles) { check_guided_flow<4>(); }
+
 TEST(GalerkinFlow, TooFewGaussPointsMakeTheStepSingular) {
   // A cubic with one Gauss point (and a quartic with two) cannot see every direction of the
   // interval: the step matrix is singular, and the regularity check names the step.
