@@ -104,7 +104,8 @@ class ShootingSystem : public NonlinearSystem {
     return true;
   }
   // The unscaled Jacobian of the last evaluation that computed one, and where: at convergence,
-  // the last Newton iterate's, one step from the solution (for diagnostics that need no exact
+  // the last Newton iterate's, one step from the solution, or two after a closing chord step
+  // (kinsol_backend.cpp) (for diagnostics that need no exact
   // point: the rank and condition there are those of the solution to the digits reported).
   const SparseJacobian& last_jacobian() const { return last_J_; }
   const Eigen::VectorXd& last_jacobian_point() const { return last_J_x_; }
