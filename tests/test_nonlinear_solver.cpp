@@ -67,6 +67,15 @@ struct Recorded : NonlinearSystem {
   }
 };
 
+// Every Jacobian KINSOL asked for was announced by the hint at that point's residual.
+void expect_every_jacobian_announced(const Recorded& f) {
+  for (const Eigen::VectorXd& j : f.jacobians) {
+    bool announced = false;
+    for (const auto& [point, was_hinted] : f.residuals) announced = announced || (was_hinted && point == j);
+    EXPECT_TRUE(announced) << "a Jacobian asked for where no residual was hinted";
+  }
+}
+
 }  // namespace
 
 // The hint lets a shooting system compute the Jacobian in the residual's sweep (one flow with
@@ -89,11 +98,7 @@ TEST(NonlinearSolver, JacobianHintsPrecedeJacobianRequestsOnly) {
     for (const Eigen::VectorXd& j : f.jacobians) asked = asked || j == point;
     EXPECT_TRUE(asked) << "a hinted residual at a point where no Jacobian was asked for";
   }
-  for (const Eigen::VectorXd& j : f.jacobians) {
-    bool announced = false;
-    for (const auto& [point, was_hinted] : f.residuals) announced = announced || (was_hinted && point == j);
-    EXPECT_TRUE(announced) << "a Jacobian asked for where no residual was hinted";
-  }
+  expect_every_jacobian_announced(f);
   EXPECT_GE(hinted, 3);  // 5 iterations from |e| = 0.8: 0.25, 0.029, 4e-4, 8e-8, 3e-15
   EXPECT_FALSE(f.residuals.back().second) << "the converged iterate was hinted";
   EXPECT_FALSE(f.hint) << "the hint is left set after the solve";
@@ -116,11 +121,7 @@ TEST(NonlinearSolver, AChordStepEndsAQuadraticallyConvergingSolve) {
   ASSERT_EQ(out.status, SolverStatus::Converged) << out.message;
   EXPECT_EQ(out.iterations, 5);
   EXPECT_EQ(f.jacobians.size(), 4u) << "the last step is a chord step";
-  for (const Eigen::VectorXd& j : f.jacobians) {
-    bool announced = false;
-    for (const auto& [point, was_hinted] : f.residuals) announced = announced || (was_hinted && point == j);
-    EXPECT_TRUE(announced) << "a Jacobian asked for where no residual was hinted";
-  }
+  expect_every_jacobian_announced(f);
   std::printf("error after the chord step and its polish: %.2e\n", (x - f.a).lpNorm<Eigen::Infinity>());
   EXPECT_LT((x - f.a).lpNorm<Eigen::Infinity>(), 1e-13);
 }
