@@ -218,7 +218,8 @@ struct NodalScheme {
   static Flow flow(const BVP& bvp, const NewtonOptions& step) { return Flow(bvp.problem, bvp.h(), step); }
   // The closures' rows are not probed for linearity: every iteration evaluates its Jacobian.
   static bool affine(const BVP&, const NewtonOptions&) { return false; }
-  // The nodal flow takes no guide (guide_bytes_per_step: 0; its steps are cheap to start).
+  // The nodal flow takes no guide (guide_bytes_per_step: 0): guided starts are written for the
+  // Galerkin flows with a group only (galerkin_flow.hpp).
   static constexpr size_t guide_bytes_per_step = 0;
   static Run run(const Flow& flow, const State& start, int /*index*/, int steps, const Eigen::MatrixXd* seed,
                  const Run* /*guide*/ = nullptr, bool /*record*/ = false) {
