@@ -8,6 +8,8 @@
 
 #include "scalar_tower.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace lpshoot::detail {
@@ -21,35 +23,88 @@ constexpr double series_coefficient(int j, int shift) {
   return ((j % 2 == 0) ? 1.0 : -1.0) / fact;
 }
 
-// sum_j (-1)^j w^(2j) / (2j + 1 + shift)!  for shift = 0 (sinc), 1 (cosc / w) and 2
-// ((w - sin w) / w^3), by Horner.
+// How many derivatives a series is evaluated with: Poly<K> K (apply_univariate), other types
+// their derivative_order, double 0.
 template <class T>
-T alternating_series(const T& w, int shift) {
-  static constexpr double c0[10] = {
-      series_coefficient(0, 0), series_coefficient(1, 0), series_coefficient(2, 0),
-      series_coefficient(3, 0), series_coefficient(4, 0), series_coefficient(5, 0),
-      series_coefficient(6, 0), series_coefficient(7, 0), series_coefficient(8, 0),
-      series_coefficient(9, 0)};
-  static constexpr double c1[10] = {
-      series_coefficient(0, 1), series_coefficient(1, 1), series_coefficient(2, 1),
-      series_coefficient(3, 1), series_coefficient(4, 1), series_coefficient(5, 1),
-      series_coefficient(6, 1), series_coefficient(7, 1), series_coefficient(8, 1),
-      series_coefficient(9, 1)};
-  static constexpr double c2[10] = {
-      series_coefficient(0, 2), series_coefficient(1, 2), series_coefficient(2, 2),
-      series_coefficient(3, 2), series_coefficient(4, 2), series_coefficient(5, 2),
-      series_coefficient(6, 2), series_coefficient(7, 2), series_coefficient(8, 2),
-      series_coefficient(9, 2)};
-  const double* c = shift == 0 ? c0 : shift == 1 ? c1 : c2;
-  // Terms kept so that the first omitted one, and its first four derivatives, are below 1e-17
-  // relative (nested duals carry second derivatives, and a Taylor2 of them two more): at w = 0
-  // three terms are exact to the fourth derivative.
-  const double a = std::abs(value(w));
-  const int terms = a < 1e-8 ? 3 : a < 1e-3 ? 4 : a < 0.05 ? 6 : 10;
+struct series_order : derivative_order<T> {};
+template <int K>
+struct series_order<Poly<K>> : std::integral_constant<int, K> {};
+
+constexpr int kSeriesTerms = 10;
+
+// radius[n], n = 1 .. 10: the largest |w| at which the omitted terms j = n .. 9 of
+// sum_j c_j w^(2j), and each of their first K derivatives, sum to at most 1e-18 (found by
+// bisection, once). Below it, n terms give every derivative the caller carries to roundoff;
+// more terms are wasted work. A term whose K-th derivative is a non-zero constant (2j <= K)
+// is never omitted.
+template <int K>
+struct SeriesRadii {
+  std::array<double, kSeriesTerms + 1> radius{};
+  explicit SeriesRadii(const double* c) {
+    auto tail = [&](int n, double a) {
+      double worst = 0;
+      for (int k = 0; k <= K; ++k) {
+        double sum = 0;
+        for (int j = n; j < kSeriesTerms; ++j) {
+          if (2 * j < k) continue;
+          double falling = 1.0;  // (2j)! / (2j - k)!
+          for (int i = 0; i < k; ++i) falling *= 2 * j - i;
+          sum += std::abs(c[j]) * falling * std::pow(a, 2 * j - k);
+        }
+        worst = std::max(worst, sum);
+      }
+      return worst;
+    };
+    for (int n = 1; n < kSeriesTerms; ++n) {
+      double lo = 0, hi = 2;
+      if (tail(n, 0.0) > 1e-18) hi = 0;
+      for (int it = 0; it < 60 && hi > 0; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (tail(n, mid) <= 1e-18 ? lo : hi) = mid;
+      }
+      radius[n] = lo;
+    }
+    radius[kSeriesTerms] = 1e300;  // the caller's radius: the full series
+  }
+  int terms(double a) const {
+    int n = 1;
+    while (!(a < radius[n])) ++n;
+    return n;
+  }
+};
+
+// sum_j c_j w^(2j) by Horner, with as many terms as value(w) and T's derivatives need
+// (SeriesRadii); c holds kSeriesTerms coefficients.
+template <class T, int Tag>
+T trimmed_series(const T& w, const double* c) {
+  static const SeriesRadii<series_order<T>::value> radii(c);
+  const int terms = radii.terms(std::abs(value(w)));
   const T w2 = w * w;
   T acc = T(c[terms - 1]);
   for (int j = terms - 2; j >= 0; --j) acc = acc * w2 + c[j];
   return acc;
+}
+
+// sum_j (-1)^j w^(2j) / (2j + 1 + shift)!  for shift = 0 (sinc), 1 (cosc / w) and 2
+// ((w - sin w) / w^3). Used where |w| < 1: ten terms suffice there.
+template <class T>
+T alternating_series(const T& w, int shift) {
+  static constexpr double c0[kSeriesTerms] = {
+      series_coefficient(0, 0), series_coefficient(1, 0), series_coefficient(2, 0),
+      series_coefficient(3, 0), series_coefficient(4, 0), series_coefficient(5, 0),
+      series_coefficient(6, 0), series_coefficient(7, 0), series_coefficient(8, 0),
+      series_coefficient(9, 0)};
+  static constexpr double c1[kSeriesTerms] = {
+      series_coefficient(0, 1), series_coefficient(1, 1), series_coefficient(2, 1),
+      series_coefficient(3, 1), series_coefficient(4, 1), series_coefficient(5, 1),
+      series_coefficient(6, 1), series_coefficient(7, 1), series_coefficient(8, 1),
+      series_coefficient(9, 1)};
+  static constexpr double c2[kSeriesTerms] = {
+      series_coefficient(0, 2), series_coefficient(1, 2), series_coefficient(2, 2),
+      series_coefficient(3, 2), series_coefficient(4, 2), series_coefficient(5, 2),
+      series_coefficient(6, 2), series_coefficient(7, 2), series_coefficient(8, 2),
+      series_coefficient(9, 2)};
+  return shift == 0 ? trimmed_series<T, 0>(w, c0) : shift == 1 ? trimmed_series<T, 1>(w, c1) : trimmed_series<T, 2>(w, c2);
 }
 
 template <class T>

@@ -26,6 +26,7 @@
 #include "group_series.hpp"
 #include "groups.hpp"
 
+#include <array>
 #include <utility>
 
 namespace lpshoot {
@@ -37,23 +38,28 @@ struct GroupVelocity {
 
 namespace detail {
 
-// f(x) and f'(x) for f written once generically (in double or Poly), lifted to x's type.
-template <class T, class F>
-std::pair<T, T> apply_univariate_with_slope(const T& x, F&& impl) {
+// f_i(x) and f_i'(x) for M functions written once generically (impl(y) returns them as a
+// std::array, in double or Poly, so that they can share work), lifted to x's type.
+template <int M, class T, class F>
+std::array<std::pair<T, T>, M> apply_univariate_with_slope(const T& x, F&& impl) {
+  std::array<std::pair<T, T>, M> out;
   if constexpr (std::is_same_v<T, double>) {
-    const Poly<1> p = impl(Poly<1>::variable(x));
-    return {p.a[0], p.a[1]};
+    const auto p = impl(Poly<1>::variable(x));
+    for (int i = 0; i < M; ++i) out[i] = {p[i].a[0], p[i].a[1]};
   } else {
     constexpr int K = derivative_order<T>::value;
-    const Poly<K + 1> p = impl(Poly<K + 1>::variable(value(x)));
-    double f[K + 2];
-    double fact = 1.0;
-    for (int k = 0; k <= K + 1; ++k) {
-      if (k > 0) fact *= k;
-      f[k] = p.a[k] * fact;
+    const auto p = impl(Poly<K + 1>::variable(value(x)));
+    for (int i = 0; i < M; ++i) {
+      double f[K + 2];
+      double fact = 1.0;
+      for (int k = 0; k <= K + 1; ++k) {
+        if (k > 0) fact *= k;
+        f[k] = p[i].a[k] * fact;
+      }
+      out[i] = {lift(f, x), lift(f + 1, x)};
     }
-    return {lift(f, x), lift(f + 1, x)};
   }
+  return out;
 }
 
 // (w - sin w) / w², by its series w Σ_j (-1)^j w^(2j) / (2j + 3)! for |w| < 1 (the closed form
@@ -74,6 +80,27 @@ T se2_b2_value(const T& w) {
   return 2.0 * s * s / (w * w);
 }
 
+// SE(2)'s four functions of the angle (a1, a2, b1, b2) = (sinc w, cosc w, (w - sin w) / w²,
+// (1 - cos w) / w²), as se2_b1_value etc. would give them one by one, with the shared work
+// done once: b2 = a2 / w is the same series (or the same sine).
+template <class T>
+std::array<T, 4> se2_angle_functions(const T& w) {
+  using std::sin;
+  std::array<T, 4> f;
+  if (std::abs(value(w)) < kSeriesRadius) {
+    f[0] = alternating_series(w, 0);
+    f[3] = alternating_series(w, 1);
+    f[1] = w * f[3];
+  } else {
+    const T s = sin(w * 0.5);
+    f[0] = sin(w) / w;
+    f[1] = 2.0 * s * s / w;
+    f[3] = f[1] / w;
+  }
+  f[2] = se2_b1_value(w);
+  return f;
+}
+
 // (w/2) cot(w/2), by its series Σ_n c_n w^(2n) (from the Bernoulli numbers) for |w| < 0.5 and
 // the closed form otherwise (no cancellation there).
 template <class T>
@@ -81,7 +108,7 @@ T se2_half_cot_value(const T& w) {
   using std::cos;
   using std::sin;
   if (std::abs(value(w)) < kSeriesRadius) {
-    static constexpr double c[10] = {1.0,
+    static constexpr double c[kSeriesTerms] = {1.0,
                                      -1.0 / 12.0,
                                      -1.0 / 720.0,
                                      -1.0 / 30240.0,
@@ -91,10 +118,7 @@ T se2_half_cot_value(const T& w) {
                                      -1.0 / 74724249600.0,
                                      -3617.0 / 10670622842880000.0,
                                      -43867.0 / 5109094217170944000.0};
-    const T w2 = w * w;
-    T acc = T(c[9]);
-    for (int j = 8; j >= 0; --j) acc = acc * w2 + c[j];
-    return acc;
+    return trimmed_series<T, 3>(w, c);
   }
   const T half = w * 0.5;
   return half * cos(half) / sin(half);
@@ -155,10 +179,11 @@ struct GroupVelocity<SE2> {
     const T& w = x0(2);
     const T &w1 = x1(2), &w2 = x2(2);
     const V2 v = x0.template head<2>(), v1 = x1.template head<2>(), v2 = x2.template head<2>();
-    const auto [a1, da1] = detail::apply_univariate_with_slope(w, [](const auto& y) { return detail::sinc_value(y); });
-    const auto [a2, da2] = detail::apply_univariate_with_slope(w, [](const auto& y) { return detail::cosc_value(y); });
-    const auto [b1, db1] = detail::apply_univariate_with_slope(w, [](const auto& y) { return detail::se2_b1_value(y); });
-    const auto [b2, db2] = detail::apply_univariate_with_slope(w, [](const auto& y) { return detail::se2_b2_value(y); });
+    const auto fs = detail::apply_univariate_with_slope<4>(w, [](const auto& y) { return detail::se2_angle_functions(y); });
+    const auto& [a1, da1] = fs[0];
+    const auto& [a2, da2] = fs[1];
+    const auto& [b1, db1] = fs[2];
+    const auto& [b2, db2] = fs[3];
     // Ω_v = A v1 + (w1 B) v;  Ω'_v = A v2 + (w1 (A' + B)) v1 + (w2 B + w1² B') v.
     const T wb1 = w1 * b1, wb2 = w1 * b2;
     const T wp1 = w1 * (da1 + b1), wp2 = w1 * (b2 - da2);

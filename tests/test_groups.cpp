@@ -117,6 +117,65 @@ TEST(GroupSeries, SeriesAndClosedFormsMeetSmoothlyAtTheRadius) {
   }
 }
 
+namespace {
+// The terms j = n .. 14 of Σ_j c_j w^(2j), k-th derivative, in long double (the coefficients
+// (-1)^j / (2j + 1 + shift)! to j = 14; their absolute values for a bound).
+long double series_tail(int shift, int n, int k, long double a, bool bound = true) {
+  long double sum = 0;
+  for (int j = n; j < 15; ++j) {
+    if (2 * j < k) continue;
+    long double c = 1;
+    for (int i = 2; i <= 2 * j + 1 + shift; ++i) c /= i;
+    if (!bound && j % 2 == 1) c = -c;
+    long double falling = 1;
+    for (int i = 0; i < k; ++i) falling *= 2 * j - i;
+    sum += c * falling * std::pow(a, static_cast<long double>(2 * j - k));
+  }
+  return sum;
+}
+
+template <int K>
+void expect_fewest_terms_to_roundoff(int shift) {
+  double c[detail::kSeriesTerms];
+  for (int j = 0; j < detail::kSeriesTerms; ++j) c[j] = detail::series_coefficient(j, shift);
+  const detail::SeriesRadii<K> radii(c);
+  auto worst_tail = [&](int n, long double a) {
+    long double worst = 0;
+    for (int k = 0; k <= K; ++k) worst = std::max(worst, series_tail(shift, n, k, a));
+    return worst;
+  };
+  for (int i = 0; i < 1000; ++i) {
+    const double a = i < 20 ? std::pow(10.0, -19 + i) : (i - 20) / 980.0;  // 1e-19 .. 1, then 0 .. 1
+    const int n = radii.terms(a);
+    SCOPED_TRACE(testing::Message() << "K " << K << ", shift " << shift << ", |w| " << a << ", terms " << n);
+    ASSERT_GE(n, 1);
+    ASSERT_LE(n, detail::kSeriesTerms);
+    if (n < detail::kSeriesTerms) EXPECT_LE(worst_tail(n, a), 1.1e-18L);  // the radii omit j >= 10: +0.1%
+    if (n > 1) EXPECT_GT(worst_tail(n - 1, a), 0.9e-18L);  // no term is wasted
+    // The series in Poly<K> (Taylor coefficients f^(k) / k!) against the long double sum.
+    const Poly<K> p = detail::alternating_series(Poly<K>::variable(a), shift);
+    long double fact = 1;
+    for (int k = 0; k <= K; ++k) {
+      if (k > 0) fact *= k;
+      EXPECT_NEAR(p.a[k], static_cast<double>(series_tail(shift, 0, k, a, false) / fact), 4e-16) << "derivative " << k;
+    }
+  }
+}
+}  // namespace
+
+// The sinc-type series keep, at each |w|, the fewest terms whose omission costs each carried
+// derivative at most 1e-18: too few would fail the first check, too many the second.
+TEST(GroupSeries, SeriesKeepTheFewestTermsThatReachRoundoffInEveryDerivative) {
+  for (int shift = 0; shift <= 2; ++shift) {
+    expect_fewest_terms_to_roundoff<0>(shift);
+    expect_fewest_terms_to_roundoff<1>(shift);
+    expect_fewest_terms_to_roundoff<2>(shift);
+    expect_fewest_terms_to_roundoff<3>(shift);
+    expect_fewest_terms_to_roundoff<4>(shift);
+    expect_fewest_terms_to_roundoff<5>(shift);
+  }
+}
+
 TEST(GroupSeries, WrapAngle) {
   EXPECT_NEAR(detail::wrap_angle(3 * M_PI + 0.1), -M_PI + 0.1, 1e-14);
   EXPECT_NEAR(detail::wrap_angle(-0.2), -0.2, 0.0);
