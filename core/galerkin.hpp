@@ -89,12 +89,19 @@ GroupCurveEnds<Sch, T> group_curve_ends(const typename Sch::Model& model, const 
   return e;
 }
 
-// The jet q = (p, p', p'', Ω, Ω') at Gauss point i.
+// What the jet at Gauss point i is made of: p, p', p'' and the time derivatives ξ, ξ', ξ'' of
+// the group curve's algebra part (absent without a group). They are linear in the interval's
+// shape coordinates (x, v, X2, V1, shape bubbles) and in the group curve's ends and bubbles;
+// the jet is nonlinear in them only through the body velocity and the connection
+// (jet_from_inputs). galerkin_group.hpp differentiates the two stages separately.
 template <class Sch, class T>
-Jet<typename Sch::Model, T> jet_at(const typename Sch::Model& model, const Interval<Sch, T>& iv,
-                                   const GroupCurveEnds<Sch, T>& ends, int i, double h) {
-  using C = typename Sch::Model;
-  using G = typename Sch::Group;
+struct JetInputs {
+  Vec<T, Sch::r> p, dp, ddp;
+  Vec<T, Sch::d> xi0, xi1, xi2;
+};
+
+template <class Sch, class T>
+JetInputs<Sch, T> jet_inputs_at(const Interval<Sch, T>& iv, const GroupCurveEnds<Sch, T>& ends, int i, double h) {
   constexpr int r = Sch::r, d = Sch::d;
   const auto& B = GalerkinTable<Sch::degree, Sch::gauss>::get().basis[i];
   const double tau = GalerkinTable<Sch::degree, Sch::gauss>::get().c[i];
@@ -108,17 +115,17 @@ Jet<typename Sch::Model, T> jet_at(const typename Sch::Model& model, const Inter
     }
     return s;
   };
-  Jet<C, T> q;
-  q.p = shape_part(0);
-  q.dp = shape_part(1);
+  JetInputs<Sch, T> u;
+  u.p = shape_part(0);
+  u.dp = shape_part(1);
   for (int a = 0; a < r; ++a) {
-    q.p(a) = q.p(a) * (h * h);
-    add_scaled(q.p(a), 1.0, iv.x(a));
-    add_scaled(q.p(a), h * tau, iv.v(a));
-    q.dp(a) = q.dp(a) * h;
-    add_scaled(q.dp(a), 1.0, iv.v(a));
+    u.p(a) = u.p(a) * (h * h);
+    add_scaled(u.p(a), 1.0, iv.x(a));
+    add_scaled(u.p(a), h * tau, iv.v(a));
+    u.dp(a) = u.dp(a) * h;
+    add_scaled(u.dp(a), 1.0, iv.v(a));
   }
-  q.ddp = shape_part(2);
+  u.ddp = shape_part(2);
   if constexpr (d > 0) {
     // The time derivatives ξ^(k)(t_i), k = 0, 1, 2 (h^(-k) times the τ-derivatives).
     auto xi_derivative = [&](int k) {
@@ -132,15 +139,40 @@ Jet<typename Sch::Model, T> jet_at(const typename Sch::Model& model, const Inter
       }
       return s;
     };
-    body_velocity_jet<G, T>(xi_derivative(0), xi_derivative(1), xi_derivative(2), q.Omega, q.dOmega);
+    u.xi0 = xi_derivative(0);
+    u.xi1 = xi_derivative(1);
+    u.xi2 = xi_derivative(2);
+  }
+  return u;
+}
+
+// The jet q = (p, p', p'', Ω, Ω') from its inputs: Ω, Ω' the body velocity of exp(ξ) and its
+// derivative, plus 𝒜(p) p' and its time derivative.
+template <class Sch, class T>
+Jet<typename Sch::Model, T> jet_from_inputs(const typename Sch::Model& model, const JetInputs<Sch, T>& u) {
+  using C = typename Sch::Model;
+  Jet<C, T> q;
+  q.p = u.p;
+  q.dp = u.dp;
+  q.ddp = u.ddp;
+  if constexpr (Sch::d > 0) {
+    body_velocity_jet<typename Sch::Group, T>(u.xi0, u.xi1, u.xi2, q.Omega, q.dOmega);
     if constexpr (detail::HasConnectionForm<C, T>::value) {  // + 𝒜(p) p' and its time derivative
-      Vec<T, d> cv, dcv;
+      Vec<T, Sch::d> cv, dcv;
       connection_jet(model, q.p, q.dp, q.ddp, cv, dcv);
       q.Omega += cv;
       q.dOmega += dcv;
     }
   }
+  (void)model;
   return q;
+}
+
+// The jet q = (p, p', p'', Ω, Ω') at Gauss point i.
+template <class Sch, class T>
+Jet<typename Sch::Model, T> jet_at(const typename Sch::Model& model, const Interval<Sch, T>& iv,
+                                   const GroupCurveEnds<Sch, T>& ends, int i, double h) {
+  return jet_from_inputs<Sch, T>(model, jet_inputs_at(iv, ends, i, h));
 }
 
 // The two parts of L~ = L0 + λ · C on one interval: L0 = h Σ_i b_i ℓ(q_i) and the constraint

@@ -2,11 +2,11 @@
 // (issue 9): the counterpart of galerkin_flat.hpp, for a step's sensitivity.
 //
 // An interval's coordinates y = (x, v, Ω, X2, V1, O1, δ, bubbles) (the state's layout, W moved
-// to W exp(h δ)) and its multipliers λ. L~ and its symmetric Hessian in y come from one
-// evaluation in Hess<ny> (hessian_scalar.hpp), instead of two evaluations in nested duals per
-// step (interval n in its unknowns and base node, interval n-1 in its coordinates, each against
-// the 2r + 2d node perturbations). Each interval's derivatives are computed once, at its
-// solution, and carried to the next step, where it is the state.
+// to W exp(h δ)) and its multipliers λ. L~ with its gradient and Hessian in y
+// (galerkin_group_interval.hpp) replaces two evaluations in nested duals per step (interval n in
+// its unknowns and base node, interval n-1 in its coordinates, each against the 2r + 2d node
+// perturbations). Each interval's derivatives are computed once, at its solution, and carried to
+// the next step, where it is the state.
 //
 // The node perturbation e = (e_x, e_v, e_Ω, η) of galerkin.hpp (perturb_node) moves interval
 // n-1 to W exp(h δ) exp(h η) and interval n to exp(-h η) W = W exp(-h Ad_{W^{-1}} η); the
@@ -22,62 +22,9 @@
 
 #include "galerkin.hpp"
 #include "galerkin_flat.hpp"
-#include "hessian_scalar.hpp"
+#include "galerkin_group_interval.hpp"
 
 namespace lpshoot {
-
-// The state interval with its smooth tangent coordinates (all but the multipliers, the last
-// Q m) seeded in columns first .. first + state - Q m - 1 of T.
-template <class Sch, class T>
-Interval<Sch, T> seeded_state(const Interval<Sch, double>& state, double h, int first) {
-  using G = typename Sch::Group;
-  constexpr int r = Sch::r, d = Sch::d, nb = Sch::aux - multiplier_count<Sch>;
-  Interval<Sch, T> s = state.template cast<T>();
-  for (int a = 0; a < r; ++a) {
-    s.x(a) = T::variable(state.x(a), first + Sch::x_off + a);
-    s.v(a) = T::variable(state.v(a), first + Sch::v_off + a);
-    s.X2(a) = T::variable(state.X2(a), first + Sch::X2_off + a);
-    s.V1(a) = T::variable(state.V1(a), first + Sch::V1_off + a);
-  }
-  for (int a = 0; a < d; ++a) {
-    s.Om(a) = T::variable(state.Om(a), first + Sch::Om_off + a);
-    s.O1(a) = T::variable(state.O1(a), first + Sch::O1_off + a);
-  }
-  if constexpr (d > 0) {
-    typename G::template Tangent<T> delta;
-    for (int a = 0; a < d; ++a) delta(a) = T::variable(0.0, first + Sch::W_off + a) * h;  // W exp(h δ)
-    s.W = G::compose(s.W, G::template exp<T>(delta));
-  }
-  for (int a = 0; a < nb; ++a) s.w(a) = T::variable(state.w(a), first + Sch::aux_off + a);
-  return s;
-}
-
-// One interval's L~ = L0 + λ · C with its gradient and Hessian in (y, λ) (y in the state's
-// layout, W exp(h δ)), from one evaluation in Hess<ny>.
-template <class Sch>
-IntervalDerivatives<Sch> group_interval_derivatives(const typename Sch::Model& model, const Interval<Sch, double>& iv,
-                                                    double h) {
-  using D = IntervalDerivatives<Sch>;
-  constexpr int ny = D::ny, nm = D::nm;
-  using T = Hess<ny>;
-  const Interval<Sch, T> s = seeded_state<Sch, T>(iv, h, 0);
-  T L0;
-  Vec<T, nm> C;
-  interval_parts(model, s, h, L0, C);
-  D out;
-  out.hessian.setZero();
-  for (int c = 0; c < nm; ++c) {
-    const double lambda = iv.w(Sch::multipliers(0) + c);
-    if (lambda != 0.0) add_scaled(L0, lambda, C(c));
-    out.gradient(ny + c) = C(c).v;
-    for (int i = 0; i < ny; ++i) out.hessian(i, ny + c) = out.hessian(ny + c, i) = C(c).g[i];
-  }
-  for (int i = 0; i < ny; ++i) {
-    out.gradient(i) = L0.g[i];
-    for (int j = i; j < ny; ++j) out.hessian(i, j) = out.hessian(j, i) = L0.H[T::at(i, j)];
-  }
-  return out;
-}
 
 // B(u, w) = g · [u, w] on the basis of the algebra: B(i, j) = g · [e_i, e_j], from
 // [X, Y] = d/dt Ad_{exp(tX)} Y at t = 0.

@@ -281,3 +281,71 @@ TEST(ConnectionJet, ConstantFormsTakeTheDoublePathOnlyWhenExact) {
     EXPECT_NE(dcv(2).d[0].v, 0.0);
   }
 }
+
+namespace {
+// A model with every part of the jet nonlinear: a shape-dependent connection on SE(2) × SO(2),
+// a Lagrangian mixing p, p', p'', Ω and Ω', one constraint.
+struct CurvedModel {
+  using Group = Product<SE2, SO2>;
+  static constexpr int shape_dim = 2;
+  static constexpr int num_constraints = 1;
+  template <class T>
+  T lagrangian(const Jet<CurvedModel, T>& q) const {
+    using std::cos, std::sin;
+    return 0.5 * q.ddp.squaredNorm() + cos(q.p(0)) * q.Omega.squaredNorm() + q.dOmega(0) * q.dp(1) +
+           0.3 * sin(q.Omega(2) * q.p(1)) + 0.2 * q.dOmega(3) * q.dOmega(1);
+  }
+  template <class T>
+  Vec<T, 1> constraints(const Jet<CurvedModel, T>& q) const {
+    using std::sin;
+    return Vec<T, 1>(q.Omega(3) - q.dp(0) * sin(q.p(1)) + q.dOmega(2) * q.Omega(0));
+  }
+  template <class T>
+  Eigen::Matrix<T, 4, 2> connection_form(const Vec<T, 2>& p) const {
+    using std::cos, std::sin;
+    Eigen::Matrix<T, 4, 2> A;
+    A << sin(p(0)), p(1) * p(1), T(0.3), cos(p(1)) * p(0), p(0) * p(0) * p(0), T(0.5), T(0.1) * p(1), T(-0.2);
+    return A;
+  }
+};
+
+// The chain rule through the jet inputs against Hess<ny> through everything: gradient and
+// Hessian (multiplier rows included) to roundoff. Dropping the μ term (the ends' curvature) or
+// a column of J_i shows as an O(1) relative difference.
+template <class Sch>
+double chained_vs_direct(const typename Sch::Model& model, const Interval<Sch, double>& iv, double h) {
+  const auto a = group_interval_derivatives_chained<Sch>(model, iv, h);
+  const auto b = group_interval_derivatives_direct<Sch>(model, iv, h);
+  return std::max((a.gradient - b.gradient).cwiseAbs().maxCoeff() / b.gradient.cwiseAbs().maxCoeff(),
+                  (a.hessian - b.hessian).cwiseAbs().maxCoeff() / b.hessian.cwiseAbs().maxCoeff());
+}
+
+template <int S>
+double curved_chained_vs_direct(double h, std::mt19937& rng) {
+  using Sch = Galerkin<CurvedModel, S>;
+  std::uniform_real_distribution<double> u(-1, 1);
+  Interval<Sch, double> iv;
+  for (int a = 0; a < Sch::r; ++a) iv.x(a) = u(rng), iv.v(a) = u(rng), iv.X2(a) = u(rng), iv.V1(a) = u(rng);
+  for (int a = 0; a < Sch::d; ++a) iv.Om(a) = u(rng), iv.O1(a) = u(rng);
+  iv.W = Sch::Group::template exp<double>(Vec<double, Sch::d>(u(rng), u(rng), u(rng), u(rng)));
+  for (int a = 0; a < Sch::aux; ++a) iv.w(a) = u(rng);
+  return chained_vs_direct<Sch>(CurvedModel{}, iv, h);
+}
+}  // namespace
+
+TEST(GalerkinGroupInterval, ChainRuleThroughTheJetInputsMatchesTheDirectHessian) {
+  BeanieModel beanie;
+  beanie.par = {1.0, 1.0, 0.5, 1.0};
+  std::mt19937 rng(29);
+  double worst = 0;
+  for (double h : {0.05, 0.5}) {
+    for (int trial = 0; trial < 4; ++trial) {
+      worst = std::max(worst, chained_vs_direct<BeanieGalerkin<3>>(beanie, generic_interval<BeanieGalerkin<3>>(beanie, rng), h));
+      worst = std::max(worst, chained_vs_direct<BeanieGalerkin<4>>(beanie, generic_interval<BeanieGalerkin<4>>(beanie, rng), h));
+      worst = std::max(worst, curved_chained_vs_direct<3>(h, rng));
+      worst = std::max(worst, curved_chained_vs_direct<4>(h, rng));
+    }
+  }
+  std::printf("interval derivatives, chain rule through the jet vs Hess<ny>: max relative difference %.2e\n", worst);
+  EXPECT_LT(worst, 1e-13);
+}

@@ -1,0 +1,242 @@
+// One Galerkin interval's L~ = L0 + λ · C with its gradient and Hessian in its coordinates, with
+// a group (d > 0; issue 9). y = (x, v, Ω, X2, V1, O1, δ, bubbles) in the state's layout, W moved
+// to W exp(h δ), and the multipliers λ.
+//
+// By the chain rule through each Gauss point's jet inputs u = (p, p', p'', ξ, ξ', ξ'')
+// (galerkin.hpp, jet_inputs_at), 3r + 3d of them. They are linear in y and in the group curve's
+// ends e = (ζ, ω0, ω1) (3d values, nonlinear in y: ζ = log(W exp(h δ)), ω1 = Jr(ζ)^{-1} (...)):
+//   u_i = A_i e(y) + B_i y,   ∂u_i/∂y = J_i = A_i ∂e/∂y + B_i,   ∇²u_i = Σ_j (A_i)_{·j} ∇²e_j.
+// With φ_i = ℓ + λ_i · χ on the jet made from u_i (jet_from_inputs), w_i = h b_i:
+//   ∇_y L~  = Σ_i w_i J_iᵀ ∇φ_i,
+//   ∇²_y L~ = Σ_i w_i J_iᵀ ∇²φ_i J_i + Σ_j μ_j ∇²e_j,   μ = Σ_i w_i A_iᵀ ∇φ_i,
+//   ∂C_{i,c}/∂y = w_i J_iᵀ ∇χ_c.
+// ∇φ_i and ∇²φ_i are taken in the 3r + 3d directions of u (Hess<3r + 3d>), and only e carries
+// all ny directions, once per interval: the body velocity's closed form and ℓ no longer run in
+// Hess<ny>. Used where 3r + 3d < ny (with bubbles); otherwise the direct evaluation
+// (group_interval_derivatives_direct), which is also the tests' reference.
+#pragma once
+
+#include "galerkin.hpp"
+#include "galerkin_flat.hpp"
+#include "hessian_scalar.hpp"
+
+namespace lpshoot {
+
+// The state interval with its smooth tangent coordinates (all but the multipliers, the last
+// Q m) seeded in columns first .. first + state - Q m - 1 of T; without `bubbles`, the bubbles
+// are left constant and T needs only the first 4r + 3d columns (x, v, Ω, X2, V1, O1, δ).
+template <class Sch, class T>
+Interval<Sch, T> seeded_state(const Interval<Sch, double>& state, double h, int first, bool bubbles = true) {
+  using G = typename Sch::Group;
+  constexpr int r = Sch::r, d = Sch::d, nb = Sch::aux - multiplier_count<Sch>;
+  Interval<Sch, T> s = state.template cast<T>();
+  for (int a = 0; a < r; ++a) {
+    s.x(a) = T::variable(state.x(a), first + Sch::x_off + a);
+    s.v(a) = T::variable(state.v(a), first + Sch::v_off + a);
+    s.X2(a) = T::variable(state.X2(a), first + Sch::X2_off + a);
+    s.V1(a) = T::variable(state.V1(a), first + Sch::V1_off + a);
+  }
+  for (int a = 0; a < d; ++a) {
+    s.Om(a) = T::variable(state.Om(a), first + Sch::Om_off + a);
+    s.O1(a) = T::variable(state.O1(a), first + Sch::O1_off + a);
+  }
+  if constexpr (d > 0) {
+    typename G::template Tangent<T> delta;
+    for (int a = 0; a < d; ++a) delta(a) = T::variable(0.0, first + Sch::W_off + a) * h;  // W exp(h δ)
+    s.W = G::compose(s.W, G::template exp<T>(delta));
+  }
+  if (bubbles)
+    for (int a = 0; a < nb; ++a) s.w(a) = T::variable(state.w(a), first + Sch::aux_off + a);
+  return s;
+}
+
+// One interval's L~ = L0 + λ · C with its gradient and Hessian in (y, λ) (y in the state's
+// layout, W exp(h δ)), from one evaluation in Hess<ny>: every step of the jet carries all ny
+// directions. The reference for group_interval_derivatives.
+template <class Sch>
+IntervalDerivatives<Sch> group_interval_derivatives_direct(const typename Sch::Model& model, const Interval<Sch, double>& iv,
+                                                    double h) {
+  using D = IntervalDerivatives<Sch>;
+  constexpr int ny = D::ny, nm = D::nm;
+  using T = Hess<ny>;
+  const Interval<Sch, T> s = seeded_state<Sch, T>(iv, h, 0);
+  T L0;
+  Vec<T, nm> C;
+  interval_parts(model, s, h, L0, C);
+  D out;
+  out.hessian.setZero();
+  for (int c = 0; c < nm; ++c) {
+    const double lambda = iv.w(Sch::multipliers(0) + c);
+    if (lambda != 0.0) add_scaled(L0, lambda, C(c));
+    out.gradient(ny + c) = C(c).v;
+    for (int i = 0; i < ny; ++i) out.hessian(i, ny + c) = out.hessian(ny + c, i) = C(c).g[i];
+  }
+  for (int i = 0; i < ny; ++i) {
+    out.gradient(i) = L0.g[i];
+    for (int j = i; j < ny; ++j) out.hessian(i, j) = out.hessian(j, i) = L0.H[T::at(i, j)];
+  }
+  return out;
+}
+
+// The linear maps of jet_inputs_at, u_i = A_i e + B_i y (see the file comment), at every Gauss
+// point for one h: jet_inputs_at has no constant term, and its coefficients depend on h only.
+// Read off one evaluation in first-order duals (y in directions 0 .. ny-1, e after).
+template <class Sch>
+struct JetInputMaps {
+  static constexpr int r = Sch::r, d = Sch::d, nu = 3 * r + 3 * d, ny = IntervalDerivatives<Sch>::ny, ne = 3 * d;
+  using TL = Dual<double, ny + ne>;
+  double h = 0;
+  std::array<Eigen::Matrix<double, nu, ne>, Sch::gauss> A;
+  std::array<Eigen::Matrix<double, nu, ny>, Sch::gauss> B;
+
+  explicit JetInputMaps(double step) : h(step) {
+    Interval<Sch, double> zero;
+    zero.x.setZero(), zero.v.setZero(), zero.X2.setZero(), zero.V1.setZero(), zero.Om.setZero(), zero.O1.setZero();
+    zero.w.setZero();
+    Interval<Sch, TL> iv = zero.template cast<TL>();
+    for (int a = 0; a < r; ++a) {
+      iv.x(a) = TL::variable(0.0, Sch::x_off + a);
+      iv.v(a) = TL::variable(0.0, Sch::v_off + a);
+      iv.X2(a) = TL::variable(0.0, Sch::X2_off + a);
+      iv.V1(a) = TL::variable(0.0, Sch::V1_off + a);
+    }
+    for (int a = 0; a < Sch::aux - multiplier_count<Sch>; ++a) iv.w(a) = TL::variable(0.0, Sch::aux_off + a);
+    GroupCurveEnds<Sch, TL> e;
+    for (int a = 0; a < d; ++a) {
+      e.zeta(a) = TL::variable(0.0, ny + a);
+      e.omega0(a) = TL::variable(0.0, ny + d + a);
+      e.omega1(a) = TL::variable(0.0, ny + 2 * d + a);
+    }
+    for (int i = 0; i < Sch::gauss; ++i) {
+      const JetInputs<Sch, TL> u = jet_inputs_at(iv, e, i, h);
+      int k = 0;
+      auto put = [&](const TL& x) {
+        for (int c = 0; c < ny; ++c) B[i](k, c) = x.d[c];
+        for (int c = 0; c < ne; ++c) A[i](k, c) = x.d[ny + c];
+        ++k;
+      };
+      for (int a = 0; a < r; ++a) put(u.p(a));
+      for (int a = 0; a < r; ++a) put(u.dp(a));
+      for (int a = 0; a < r; ++a) put(u.ddp(a));
+      for (int a = 0; a < d; ++a) put(u.xi0(a));
+      for (int a = 0; a < d; ++a) put(u.xi1(a));
+      for (int a = 0; a < d; ++a) put(u.xi2(a));
+    }
+  }
+};
+
+// The maps for h, rebuilt when h changes (one set per thread: a flow's steps share h).
+template <class Sch>
+const JetInputMaps<Sch>& jet_input_maps(double h) {
+  thread_local JetInputMaps<Sch> maps(h);
+  if (maps.h != h) maps = JetInputMaps<Sch>(h);
+  return maps;
+}
+
+// The jet inputs as nu seeded variables of T (the order of JetInputMap).
+template <class Sch, class T>
+JetInputs<Sch, T> seeded_jet_inputs(const Vec<double, 3 * Sch::r + 3 * Sch::d>& value) {
+  constexpr int r = Sch::r, d = Sch::d;
+  JetInputs<Sch, T> u;
+  for (int a = 0; a < r; ++a) {
+    u.p(a) = T::variable(value(a), a);
+    u.dp(a) = T::variable(value(r + a), r + a);
+    u.ddp(a) = T::variable(value(2 * r + a), 2 * r + a);
+  }
+  for (int a = 0; a < d; ++a) {
+    u.xi0(a) = T::variable(value(3 * r + a), 3 * r + a);
+    u.xi1(a) = T::variable(value(3 * r + d + a), 3 * r + d + a);
+    u.xi2(a) = T::variable(value(3 * r + 2 * d + a), 3 * r + 2 * d + a);
+  }
+  return u;
+}
+
+// The file comment's chain rule.
+template <class Sch>
+IntervalDerivatives<Sch> group_interval_derivatives_chained(const typename Sch::Model& model,
+                                                            const Interval<Sch, double>& iv, double h) {
+  using D = IntervalDerivatives<Sch>;
+  constexpr int r = Sch::r, d = Sch::d, m = Sch::m, ny = D::ny, ne = 3 * d, nu = 3 * r + 3 * d;
+  constexpr int ny_e = 4 * r + 3 * d;  // x, v, Ω, X2, V1, O1, δ: the ends' arguments
+  using TE = Hess<ny_e>;
+  using TU = Hess<nu>;
+  const auto& tab = GalerkinTable<Sch::degree, Sch::gauss>::get();
+
+  // The ends e(y) with their gradients and Hessians. They do not depend on the bubbles, the
+  // last coordinates of y: Hess in the first ny_e only.
+  const GroupCurveEnds<Sch, TE> ends = group_curve_ends(model, seeded_state<Sch, TE>(iv, h, 0, false), h);
+  const TE* e[ne];
+  for (int a = 0; a < d; ++a) e[a] = &ends.zeta(a), e[d + a] = &ends.omega0(a), e[2 * d + a] = &ends.omega1(a);
+  Eigen::Matrix<double, ne, ny> De = Eigen::Matrix<double, ne, ny>::Zero();
+  Vec<double, ne> ev;
+  for (int j = 0; j < ne; ++j) {
+    ev(j) = e[j]->v;
+    for (int c = 0; c < ny_e; ++c) De(j, c) = e[j]->g[c];
+  }
+  // y (δ = 0: W is the base point of its perturbation).
+  Vec<double, ny> y;
+  y << iv.x, iv.v, iv.Om, iv.X2, iv.V1, iv.O1, Vec<double, d>::Zero(), iv.w.template head<ny - ny_e>();
+  const JetInputMaps<Sch>& maps = jet_input_maps<Sch>(h);
+
+  D out;
+  out.gradient.setZero();
+  out.hessian.setZero();
+  Eigen::Matrix<double, ny, ny> H = Eigen::Matrix<double, ny, ny>::Zero();
+  Vec<double, ne> mu = Vec<double, ne>::Zero();
+  for (int i = 0; i < Sch::gauss; ++i) {
+    const double w = h * tab.b[i];
+    const Eigen::Matrix<double, nu, ne>& A = maps.A[i];
+    const Vec<double, nu> u = A * ev + maps.B[i] * y;
+    const Eigen::Matrix<double, nu, ny> Ju = maps.B[i] + A.lazyProduct(De);
+    const Jet<typename Sch::Model, TU> q = jet_from_inputs<Sch, TU>(model, seeded_jet_inputs<Sch, TU>(u));
+    TU phi = model.template lagrangian<TU>(q);
+    if constexpr (m > 0) {
+      const Vec<TU, m> chi = model.template constraints<TU>(q);
+      for (int c = 0; c < m; ++c) {
+        const int k = i * m + c;
+        add_scaled(phi, iv.w(Sch::multipliers(0) + k), chi(c));
+        out.gradient(ny + k) = w * chi(c).v;
+        Vec<double, nu> gc;
+        for (int a = 0; a < nu; ++a) gc(a) = chi(c).g[a];
+        out.hessian.col(ny + k).template head<ny>().noalias() = w * (Ju.transpose() * gc);
+        out.hessian.row(ny + k).template head<ny>() = out.hessian.col(ny + k).template head<ny>().transpose();
+      }
+    }
+    Vec<double, nu> g;
+    Eigen::Matrix<double, nu, nu> Hu;
+    for (int a = 0; a < nu; ++a) {
+      g(a) = phi.g[a];
+      for (int b = a; b < nu; ++b) Hu(a, b) = Hu(b, a) = phi.H[TU::at(a, b)];
+    }
+    out.gradient.template head<ny>().noalias() += w * (Ju.transpose() * g);
+    const Eigen::Matrix<double, nu, ny> HJ = Hu.lazyProduct(Ju);
+    H.noalias() += w * Ju.transpose().lazyProduct(HJ);
+    mu.noalias() += w * (A.transpose() * g);
+  }
+  // + Σ_j μ_j ∇²e_j (packed upper triangles, the first ny_e coordinates); the upper triangle
+  // is the result, mirrored.
+  int k = 0;
+  for (int a = 0; a < ny; ++a)
+    for (int b = a; b < ny; ++b) {
+      double s = H(a, b);
+      if (b < ny_e) {
+        for (int j = 0; j < ne; ++j) s += mu(j) * e[j]->H[k];
+        ++k;
+      }
+      out.hessian(a, b) = out.hessian(b, a) = s;
+    }
+  return out;
+}
+
+// L~'s derivatives: by the chain rule where the jet has fewer inputs than the interval has
+// coordinates, directly otherwise.
+template <class Sch>
+IntervalDerivatives<Sch> group_interval_derivatives(const typename Sch::Model& model, const Interval<Sch, double>& iv,
+                                                    double h) {
+  if constexpr (3 * Sch::r + 3 * Sch::d < IntervalDerivatives<Sch>::ny)
+    return group_interval_derivatives_chained<Sch>(model, iv, h);
+  else
+    return group_interval_derivatives_direct<Sch>(model, iv, h);
+}
+
+}  // namespace lpshoot
