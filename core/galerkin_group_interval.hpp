@@ -10,10 +10,12 @@
 //   ∇_y L~  = Σ_i w_i J_iᵀ ∇φ_i,
 //   ∇²_y L~ = Σ_i w_i J_iᵀ ∇²φ_i J_i + Σ_j μ_j ∇²e_j,   μ = Σ_i w_i A_iᵀ ∇φ_i,
 //   ∂C_{i,c}/∂y = w_i J_iᵀ ∇χ_c.
-// ∇φ_i and ∇²φ_i are taken in the 3r + 3d directions of u (Hess<3r + 3d>), and only e carries
-// all ny directions, once per interval: the body velocity's closed form and ℓ no longer run in
-// Hess<ny>. Used where 3r + 3d < ny (with bubbles); otherwise the direct evaluation
-// (group_interval_derivatives_direct), which is also the tests' reference.
+// ∇φ_i and ∇²φ_i are taken in the 3r + 3d directions of u (Hess<3r + 3d>); only e carries the
+// interval's directions, once per interval and in the 4r + 3d it depends on (not the bubbles):
+// the body velocity's closed form and ℓ no longer run in Hess<ny>. Used where 3r + 3d < ny;
+// otherwise the direct evaluation (group_interval_derivatives_direct), which is also the
+// tests' reference. Beanie, Galerkin 6: Hess<12> per Gauss point and Hess<13> for e, instead of
+// Hess<17> throughout.
 #pragma once
 
 #include "galerkin.hpp"
@@ -133,7 +135,7 @@ const JetInputMaps<Sch>& jet_input_maps(double h) {
   return maps;
 }
 
-// The jet inputs as nu seeded variables of T (the order of JetInputMap).
+// The jet inputs as nu seeded variables of T, in JetInputMaps' order (p, p', p'', ξ, ξ', ξ'').
 template <class Sch, class T>
 JetInputs<Sch, T> seeded_jet_inputs(const Vec<double, 3 * Sch::r + 3 * Sch::d>& value) {
   constexpr int r = Sch::r, d = Sch::d;
