@@ -79,6 +79,24 @@ Eigen::Matrix<double, Sch::unknowns, IntervalDerivatives<Sch>::ne> group_right_m
   return Ar;
 }
 
+// A_r M without forming A_r (2 or 3 non-zeros per row but the η block): M has the interval's
+// coordinates as rows (state layout); Ad = Ad_{W^{-1}}.
+template <class Sch, int C>
+Eigen::Matrix<double, Sch::unknowns, C> group_right_map_times(double h, const Eigen::Matrix<double, Sch::d, Sch::d>& Ad,
+                                                              const Eigen::Matrix<double, IntervalDerivatives<Sch>::ne, C>& M) {
+  constexpr int r = Sch::r, d = Sch::d, nz = Sch::unknowns, nv = Sch::variation;
+  constexpr int eta = 2 * r + d;
+  Eigen::Matrix<double, nz, C> out;
+  for (int a = 0; a < r; ++a) {
+    out.row(a) = (h * h) * M.row(Sch::x_off + a) - M.row(Sch::X2_off + a);
+    out.row(r + a) = h * M.row(Sch::v_off + a) - M.row(Sch::X2_off + a) - M.row(Sch::V1_off + a);
+  }
+  for (int a = 0; a < d; ++a) out.row(2 * r + a) = h * M.row(Sch::Om_off + a) - M.row(Sch::O1_off + a);
+  out.template middleRows<d>(eta).noalias() = -Ad.transpose() * M.template middleRows<d>(Sch::W_off);
+  out.template bottomRows<nz - nv>() = M.template middleRows<nz - nv>(Sch::aux_off);
+  return out;
+}
+
 // F and J of the step (evaluate_galerkin_step's contract): from interval n's derivatives at z
 // and, for the state's columns (NO = unknowns + state) or without `fixed` (the state's part of
 // E_n), the state's (`carry`, when valid; computed otherwise). With `carry`, on return it holds
@@ -101,12 +119,12 @@ void evaluate_galerkin_step_group(const typename Sch::Model& model, double h, co
   right.x = base.x, right.v = base.v, right.Om = base.Om;
   const D dr = group_interval_derivatives<Sch>(model, right, h);
 
-  const Eigen::Matrix<double, nz, ne> Ar = group_right_map<Sch>(h, z.W);  // A_l below
-  const Eigen::Matrix<double, d, d> At = -Ar.template block<d, d>(eta, Sch::W_off);  // Ad_{W_n^{-1}}ᵀ, A_r's η block
+  const Eigen::Matrix<double, d, d> Ad = G::Ad(G::inverse(z.W));  // Ad_{W_n^{-1}}: A_r's η block is −Adᵀ
+  const Eigen::Matrix<double, d, d> At = Ad.transpose();
 
   const double inv_h = 1.0 / h;
-  F.noalias() = inv_h * (Ar * dr.gradient);
-  const Eigen::Matrix<double, nz, ne> ArH = inv_h * (Ar * dr.hessian);
+  F.noalias() = inv_h * group_right_map_times<Sch, 1>(h, Ad, dr.gradient);
+  const Eigen::Matrix<double, nz, ne> ArH = inv_h * group_right_map_times<Sch, ne>(h, Ad, dr.hessian);
   // The unknowns are interval n's coordinates from X2 on (ζ as δ); the group's term (file comment).
   J.template leftCols<nz>() = ArH.template rightCols<nz>();
   const Eigen::Matrix<double, d, d> Br = bracket_form<G>(dr.gradient.template segment<d>(Sch::W_off));
