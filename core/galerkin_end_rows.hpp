@@ -40,10 +40,10 @@ int galerkin_end_rows(const typename Sch::Model& model, const Interval<Sch, doub
     const D dv = group_interval_derivatives<Sch>(model, iv, h);
     const Eigen::Matrix<double, d, d> B = bracket_form<G>(dv.gradient.template segment<d>(Sch::W_off));
     if (initial) {
-      const Eigen::Matrix<double, nz, ne> Ar = group_right_map<Sch>(h, iv.W);
-      R.noalias() = inv_h * (Ar * dv.gradient);
-      J.noalias() = inv_h * (Ar * dv.hessian);
-      J.template block<d, d>(eta, Sch::W_off) -= 0.5 * (G::Ad(G::inverse(iv.W)).transpose() * B);
+      const Eigen::Matrix<double, d, d> Ad = G::Ad(G::inverse(iv.W));
+      R.noalias() = inv_h * group_right_map_times<Sch, 1>(h, Ad, dv.gradient);
+      J.noalias() = inv_h * group_right_map_times<Sch, ne>(h, Ad, dv.hessian);
+      J.template block<d, d>(eta, Sch::W_off) -= 0.5 * (Ad.transpose() * B);
     } else {  // A_l picks the rows X2, V1, O1 and δ
       R.template head<nv>() = group_left_rows<Sch>(dv.gradient, h);
       J.template middleRows<r>(0) = inv_h * dv.hessian.template middleRows<r>(Sch::X2_off);

@@ -56,31 +56,10 @@ Vec<double, Sch::variation> group_left_rows(const Vec<double, IntervalDerivative
   return E;
 }
 
-// A_r for an interval with group increment W: rows E (the node at the interval's base, perturbed
-// as in perturb_node), then the interval's own rows (∂L~/∂bubbles, C); columns the interval's
-// coordinates (state layout). Its η block is −Ad_{W^{-1}}ᵀ.
-template <class Sch>
-Eigen::Matrix<double, Sch::unknowns, IntervalDerivatives<Sch>::ne> group_right_map(
-    double h, const typename Sch::Group::template Element<double>& W) {
-  using G = typename Sch::Group;
-  constexpr int r = Sch::r, d = Sch::d, nz = Sch::unknowns, nv = Sch::variation, ne = IntervalDerivatives<Sch>::ne;
-  constexpr int eta = 2 * r + d;  // first η row
-  Eigen::Matrix<double, nz, ne> Ar = Eigen::Matrix<double, nz, ne>::Zero();
-  for (int a = 0; a < r; ++a) {
-    Ar(a, Sch::x_off + a) = h * h, Ar(a, Sch::X2_off + a) = -1;
-    Ar(r + a, Sch::v_off + a) = h, Ar(r + a, Sch::X2_off + a) = -1, Ar(r + a, Sch::V1_off + a) = -1;
-  }
-  const Eigen::Matrix<double, d, d> A = G::Ad(G::inverse(W));  // Ad_{W^{-1}}
-  for (int a = 0; a < d; ++a) {
-    Ar(2 * r + a, Sch::Om_off + a) = h, Ar(2 * r + a, Sch::O1_off + a) = -1;
-    for (int b = 0; b < d; ++b) Ar(eta + a, Sch::W_off + b) = -A(b, a);
-  }
-  for (int k = 0; k < Sch::aux; ++k) Ar(nv + k, Sch::aux_off + k) = 1;
-  return Ar;
-}
-
-// A_r M without forming A_r (2 or 3 non-zeros per row but the η block): M has the interval's
-// coordinates as rows (state layout); Ad = Ad_{W^{-1}}.
+// A_r M for an interval with group increment W, Ad = Ad_{W^{-1}}: A_r has rows E (the node at
+// the interval's base, perturbed as in perturb_node), then the interval's own rows (∂L~/∂bubbles,
+// C), and columns the interval's coordinates (state layout), the rows of M. It has 2 or 3
+// non-zeros per row but its η block, −Adᵀ; applied by rows, never formed.
 template <class Sch, int C>
 Eigen::Matrix<double, Sch::unknowns, C> group_right_map_times(double h, const Eigen::Matrix<double, Sch::d, Sch::d>& Ad,
                                                               const Eigen::Matrix<double, IntervalDerivatives<Sch>::ne, C>& M) {

@@ -74,7 +74,8 @@ struct SeriesRadii {
 };
 
 // sum_j c_j w^(2j) by Horner, with as many terms as value(w) and T's derivatives need
-// (SeriesRadii); c holds kSeriesTerms coefficients.
+// (SeriesRadii); c holds kSeriesTerms coefficients, always the same array for a given Tag (the
+// radii are computed once per T and Tag).
 template <class T, int Tag>
 T trimmed_series(const T& w, const double* c) {
   static const SeriesRadii<series_order<T>::value> radii(c);
