@@ -61,6 +61,9 @@ struct SolverOutcome {
   int iterations = 0;
   std::vector<double> residual_history;  // max-norm of F at each accepted iterate
   double residual_norm = 0;
+  // Not converged: full Newton steps stopped at the noise of F within 100x the tolerance, after
+  // cutting it at least a thousandfold (KINSOL; shooting: the flows' roundoff floor).
+  bool stalled_at_noise = false;
 };
 
 // Solves F(x) = 0 from x (updated in place).

@@ -141,9 +141,11 @@ ShootingResult<X> solve_from_starts(const typename SchemeFor<X>::BVP& bvp,
 
   // Conditioning and rank of the shooting Jacobian (structured: sparse QR and LU). At a converged
   // solution, the last Newton iteration's Jacobian, one step away, serves: its rank and condition
-  // are the solution's; otherwise the Jacobian at the final iterate.
+  // are the solution's; so it does after a stall at the flows' noise, whose iterates differ by
+  // that noise; otherwise the Jacobian at the final iterate (a sweep with sensitivities).
   SparseJacobian J;
-  const bool have_J = so.status == SolverStatus::Converged && system.last_jacobian().rows() == system.size()
+  const bool near = so.status == SolverStatus::Converged || so.stalled_at_noise;
+  const bool have_J = near && system.last_jacobian().rows() == system.size()
                           ? (J = system.last_jacobian(), true)
                           : system.jacobian(x, J);
   if (have_J) {
