@@ -147,3 +147,85 @@ TEST(ConditionNumber, HagersEstimateIsALowerBoundWithinASmallFactorOfTheExact) {
   const Eigen::PartialPivLU<M> lu(S);
   EXPECT_FALSE(condition_number_1(S, lu) <= 1e13);  // singular: inf or NaN, never a number
 }
+
+namespace {
+// The step equations at tiny h: F is known only to its rounding, which moves the corrections by
+// `noise` (relative to z, above the step tolerance of 1e-12) whatever the iterate; the matrix is
+// ill-conditioned (cond ~ 1e6, as the beanie's Galerkin steps at h = 2e-5).
+struct NoisySolve {
+  StepReport report;
+  V3 z;
+  int jacobians = 0, residuals = 0;
+};
+
+NoisySolve solve_noisy(const CubicSystem& sys, V3 z0, ChordMatrix<3>* chord, double noise, NewtonOptions opt) {
+  NoisySolve out;
+  out.z = z0;
+  int calls = 0;
+  auto rounding = [&]() -> V3 {
+    ++calls;
+    return V3(std::sin(12.9898 * calls), std::cos(78.233 * calls), std::sin(3.7 * calls)) * noise;
+  };
+  out.report = newton_solve<3>(
+      7, opt,
+      [&](V3& F, M3& J) {
+        ++out.jacobians;
+        J = sys.J(out.z);
+        F = sys.F(out.z) + J * rounding().cwiseProduct(V3::Ones() + out.z.cwiseAbs());
+      },
+      [&](V3& F) {
+        ++out.residuals;
+        F = sys.F(out.z) + sys.J(out.z) * rounding().cwiseProduct(V3::Ones() + out.z.cwiseAbs());
+      },
+      [&](const V3& dz) { out.z += dz; }, [&] { return V3(out.z.cwiseAbs()); }, chord);
+  return out;
+}
+
+CubicSystem stiff_system() {
+  CubicSystem s = base_system();
+  s.A.row(0) *= 1e6;
+  s.b(0) *= 1e6;
+  return s;
+}
+}  // namespace
+
+// Chord steps that contracted 4-fold (ρ ≤ 1/4, shown above the noise) and then stall at the
+// noise are converged: no fresh Jacobian is evaluated to find that out (before: one per step,
+// the most costly part of a Galerkin step at h = 2e-5). The iterate is within the noise of the
+// root.
+TEST(NewtonChord, ChordStepsThatContractedThenStallAtTheNoiseAreConverged) {
+  const CubicSystem first = stiff_system();
+  ChordMatrix<3> chord;
+  const Solve a = solve(first, V3::Zero(), &chord);
+  ASSERT_EQ(a.report.status, StepStatus::Converged) << a.report.message;
+  CubicSystem next = first;  // the next step, close: the predictor is ~1e-7 off
+  next.b += V3(1e-1, -2e-7, 1e-7);
+  const Solve exact = solve(next, a.z, nullptr);
+  ASSERT_EQ(exact.report.status, StepStatus::Converged);
+  NewtonOptions opt;
+  opt.polish_chord = true;
+  const NoisySolve s = solve_noisy(next, a.z, &chord, 3e-11, opt);
+  ASSERT_EQ(s.report.status, StepStatus::Converged) << s.report.message;
+  EXPECT_GT(chord.condition, 1e5);
+  EXPECT_EQ(s.jacobians, 0);
+  EXPECT_LE(s.report.iterations, 5);
+  EXPECT_LT(((s.z - exact.z).cwiseAbs().array() / (1.0 + exact.z.cwiseAbs().array())).maxCoeff(), 1e-9);
+}
+
+// A correction within the step tolerance is polished by chord corrections until one is within
+// rounding (16 u) or stops shrinking 4-fold: at a noise between the two (2e-13 relative), the
+// polish ends after the second correction (before: always three).
+TEST(NewtonChord, APolishStopsWhenItsCorrectionsStopShrinking) {
+  const CubicSystem first = stiff_system();
+  ChordMatrix<3> chord;
+  const Solve a = solve(first, V3::Zero(), &chord);
+  ASSERT_EQ(a.report.status, StepStatus::Converged) << a.report.message;
+  CubicSystem next = first;
+  next.b += V3(1e-3, -2e-9, 1e-9);
+  NewtonOptions opt;
+  opt.polish_chord = true;
+  const NoisySolve s = solve_noisy(next, a.z, &chord, 2e-13, opt);
+  ASSERT_EQ(s.report.status, StepStatus::Converged) << s.report.message;
+  EXPECT_EQ(s.jacobians, 0);
+  EXPECT_LE(s.residuals - s.report.iterations, 2) << "polish corrections after convergence";
+}
