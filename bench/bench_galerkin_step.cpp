@@ -53,9 +53,10 @@ void step(benchmark::State& st, const typename Sch::Model& model, const Interval
 
 // Per step of a 200-step flow from `start`, with the full state seeded (as shooting does) or not.
 template <class Sch>
-void flow(benchmark::State& st, const typename Sch::Model& model, const Interval<Sch, double>& start, bool sensitivity) {
+void flow(benchmark::State& st, const typename Sch::Model& model, const Interval<Sch, double>& start, bool sensitivity,
+          double h = kH) {
   constexpr int steps = 200;
-  const GalerkinFlow<Sch> f(model, kH);
+  const GalerkinFlow<Sch> f(model, h);
   const Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(Sch::state, Sch::state);
   for (auto _ : st) {
     auto r = f.run(start, steps, sensitivity ? &seed : nullptr, Sch::Group::template identity<double>(), 0, false);
@@ -164,12 +165,14 @@ static void BM_ElectronStepDerivatives(benchmark::State& st) {
 BENCHMARK_TEMPLATE(BM_ElectronStepDerivatives, 3)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 BENCHMARK_TEMPLATE(BM_ElectronStepDerivatives, 4)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
+// Second argument 1: h = 2e-5 (the beanie at N = 10^5), where the step equations are known only
+// to their rounding (~5e-12 relative to the unknowns) and each step's Newton ends at that noise.
 template <int S>
 static void BM_BeanieGalerkinFlow(benchmark::State& st) {
-  flow<BeanieGalerkin<S>>(st, beanie(), beanie_start<S>(beanie()), st.range(0) != 0);
+  flow<BeanieGalerkin<S>>(st, beanie(), beanie_start<S>(beanie()), st.range(0) != 0, st.range(1) ? 2e-5 : kH);
 }
-BENCHMARK_TEMPLATE(BM_BeanieGalerkinFlow, 3)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
-BENCHMARK_TEMPLATE(BM_BeanieGalerkinFlow, 4)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_BeanieGalerkinFlow, 3)->ArgsProduct({{0, 1}, {0, 1}})->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_BeanieGalerkinFlow, 4)->ArgsProduct({{0, 1}, {0, 1}})->Unit(benchmark::kMillisecond);
 
 template <int S>
 static void BM_ElectronGalerkinFlow(benchmark::State& st) {

@@ -46,8 +46,9 @@ struct NewtonOptions {
   bool reuse_constant_matrix = true;
   // A chord step that meets the tolerance leaves an error of ~ρ |dz| (ρ the chord's contraction),
   // against ~|dz|² for a Newton step. With polish_chord chord corrections follow until one is
-  // within rounding (at most 3): set by flows whose steps end in chord steps and whose momentum
-  // map must hold to roundoff (galerkin_flow.hpp).
+  // within rounding (at most 3, or until they stop shrinking: the noise), also after chord
+  // steps that stalled at the noise (newton_solve): set by flows whose steps end in chord steps
+  // and whose momentum map must hold to roundoff (galerkin_flow.hpp).
   bool polish_chord = false;
 };
 
@@ -188,22 +189,29 @@ StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian,
     const Vn dz = lu.solve(-F);
     const Vn scale = magnitude();
     correct(dz);
-    if (affine || ((dz.cwiseAbs().array() - opt.step_tolerance * (1.0 + scale.array())) <= 0.0).all()) {
-      // Polish: chord corrections until one is within rounding (16 u relative; at most 3), or
-      // stops shrinking 4-fold: the residual's noise (tiny h), which further corrections only
-      // sample (beanie Galerkin 4 at h = 2e-5: ~5e-12 relative, every step polished 3 times).
-      double polished = dz.template lpNorm<Eigen::Infinity>();
+    // Polish: chord corrections until one is within rounding (16 u relative; at most 3), or one
+    // far above it (1024 u) does not shrink 4-fold: the residual's noise at tiny h, which
+    // further corrections only sample (beanie Galerkin 4 at h = 2e-5: ~5e-12 relative, every
+    // step polished 3 times before). Closer to rounding the three go on (spherical pendulum
+    // scene: momentum drift 1.3e-15; 5.7e-15 when any correction that does not shrink ends it).
+    auto polish = [&](double last) {
       for (int p = 0; p < 3 && opt.polish_chord && !refresh && !affine; ++p) {
         residual(F);
-        if (!all_finite(F.data(), n)) return fail(StepStatus::NonFinite, "the step equations evaluated to a non-finite number");
+        if (!all_finite(F.data(), n)) return false;
         const Vn fine = lu.solve(-F);
         const Vn fine_scale = magnitude();
         correct(fine);
         if (((fine.cwiseAbs().array() - 16 * eps * (1.0 + fine_scale.array())) <= 0.0).all()) break;
         const double size = fine.template lpNorm<Eigen::Infinity>();
-        if (size > 0.25 * polished) break;
-        polished = size;
+        const bool above_rounding = ((fine.cwiseAbs().array() - 1024 * eps * (1.0 + fine_scale.array())) > 0.0).any();
+        if (above_rounding && size > 0.25 * last) break;
+        last = size;
       }
+      return true;
+    };
+    const double size = dz.template lpNorm<Eigen::Infinity>();
+    if (affine || ((dz.cwiseAbs().array() - opt.step_tolerance * (1.0 + scale.array())) <= 0.0).all()) {
+      if (!polish(size)) return fail(StepStatus::NonFinite, "the step equations evaluated to a non-finite number");
       rep.status = StepStatus::Converged;
       return rep;
     }
@@ -214,13 +222,17 @@ StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian,
     // residual can dip below the last one and return, tests/test_extremes.cpp), with a
     // correction within that noise (never beyond 1e-8 relative) is converged: another iteration
     // cannot do better.
-    // So is a chord step's, once an earlier chord step of this solve contracted 4-fold (ρ ≤ 1/4
-    // measured above the noise: a stalled correction is then noise, not slow contraction, and
-    // the iterate is within |dz| / 3 of the root); no fresh Jacobian is evaluated to find it out.
-    const double size = dz.template lpNorm<Eigen::Infinity>();
-    if ((refresh || chord_contracted) && (rep.residual > 0.25 * last_residual || size > 0.25 * last_step)) {
+    // So is a chord step's whose correction did not shrink 4-fold, once an earlier chord step of
+    // this solve did (ρ ≤ 1/4 measured above the noise: the stall is likely noise), then polished
+    // (polish_chord), which goes on while its corrections shrink (a slower contraction than
+    // measured) and so ends within rounding wherever the noise allows it. No fresh Jacobian is
+    // evaluated to find that out (beanie Galerkin 4 at h = 2e-5: one per step before).
+    const bool stalled = refresh ? rep.residual > 0.25 * last_residual || size > 0.25 * last_step
+                                 : chord_contracted && size > 0.25 * last_step;
+    if (stalled) {
       const double noise = std::min(1e-8, 64 * eps * rep.condition);
       if (((dz.cwiseAbs().array() - (opt.step_tolerance + noise) * (1.0 + scale.array())) <= 0.0).all()) {
+        if (!refresh && !polish(size)) return fail(StepStatus::NonFinite, "the step equations evaluated to a non-finite number");
         rep.status = StepStatus::Converged;
         return rep;
       }

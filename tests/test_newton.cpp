@@ -158,12 +158,17 @@ struct NoisySolve {
   int jacobians = 0, residuals = 0;
 };
 
-NoisySolve solve_noisy(const CubicSystem& sys, V3 z0, ChordMatrix<3>* chord, double noise, NewtonOptions opt) {
+// With `growth` (not 1) the noise is growth^k noise (1, 1, 1) at the k-th evaluation instead:
+// for growth = -1.5 each correction (the difference of two consecutive noises) is 1.5 times
+// the last.
+NoisySolve solve_noisy(const CubicSystem& sys, V3 z0, ChordMatrix<3>* chord, double noise, NewtonOptions opt,
+                       double growth = 1) {
   NoisySolve out;
   out.z = z0;
   int calls = 0;
   auto rounding = [&]() -> V3 {
     ++calls;
+    if (growth != 1) return V3::Ones() * noise * std::pow(growth, calls);
     return V3(std::sin(12.9898 * calls), std::cos(78.233 * calls), std::sin(3.7 * calls)) * noise;
   };
   out.report = newton_solve<3>(
@@ -213,8 +218,9 @@ TEST(NewtonChord, ChordStepsThatContractedThenStallAtTheNoiseAreConverged) {
 }
 
 // A correction within the step tolerance is polished by chord corrections until one is within
-// rounding (16 u) or stops shrinking 4-fold: at a noise between the two (2e-13 relative), the
-// polish ends after the second correction (before: always three).
+// rounding (16 u) or, far above it (1024 u), does not shrink 4-fold: at a noise between the
+// two (from 1e-13 relative, each correction 1.5 times the last), the polish ends after the
+// first correction that did not (before: always three).
 TEST(NewtonChord, APolishStopsWhenItsCorrectionsStopShrinking) {
   const CubicSystem first = stiff_system();
   ChordMatrix<3> chord;
@@ -224,7 +230,7 @@ TEST(NewtonChord, APolishStopsWhenItsCorrectionsStopShrinking) {
   next.b += V3(1e-3, -2e-9, 1e-9);
   NewtonOptions opt;
   opt.polish_chord = true;
-  const NoisySolve s = solve_noisy(next, a.z, &chord, 2e-13, opt);
+  const NoisySolve s = solve_noisy(next, a.z, &chord, 1e-13, opt, -1.5);
   ASSERT_EQ(s.report.status, StepStatus::Converged) << s.report.message;
   EXPECT_EQ(s.jacobians, 0);
   EXPECT_LE(s.residuals - s.report.iterations, 2) << "polish corrections after convergence";
