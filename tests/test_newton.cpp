@@ -33,21 +33,35 @@ struct CubicSystem {
 struct Solve {
   StepReport report;
   V3 z;
-  int jacobians = 0;
+  int jacobians = 0, residuals = 0;
 };
 
-Solve solve(const CubicSystem& sys, V3 z0, ChordMatrix<3>* chord, NewtonOptions opt = {}) {
+// With `noise`, the step equations at tiny h: F is known only to its rounding, which moves the
+// corrections by `noise` (relative to z) whatever the iterate. With `growth` (not 1) the noise
+// is growth^k noise (1, 1, 1) at the k-th evaluation instead: for growth = -1.5 each correction
+// (the difference of two consecutive noises) is 1.5 times the last.
+Solve solve(const CubicSystem& sys, V3 z0, ChordMatrix<3>* chord, NewtonOptions opt = {}, double noise = 0,
+            double growth = 1) {
   Solve out;
   out.z = z0;
+  int calls = 0;
+  auto rounding = [&]() -> V3 {
+    ++calls;
+    if (growth != 1) return V3::Ones() * noise * std::pow(growth, calls);
+    return V3(std::sin(12.9898 * calls), std::cos(78.233 * calls), std::sin(3.7 * calls)) * noise;
+  };
   out.report = newton_solve<3>(
       7, opt,
       [&](V3& F, M3& J) {
         ++out.jacobians;
-        F = sys.F(out.z);
         J = sys.J(out.z);
+        F = sys.F(out.z) + J * rounding().cwiseProduct(V3::Ones() + out.z.cwiseAbs());
       },
-      [&](V3& F) { F = sys.F(out.z); }, [&](const V3& dz) { out.z += dz; }, [&] { return V3(out.z.cwiseAbs()); },
-      chord);
+      [&](V3& F) {
+        ++out.residuals;
+        F = sys.F(out.z) + sys.J(out.z) * rounding().cwiseProduct(V3::Ones() + out.z.cwiseAbs());
+      },
+      [&](const V3& dz) { out.z += dz; }, [&] { return V3(out.z.cwiseAbs()); }, chord);
   return out;
 }
 
@@ -149,43 +163,7 @@ TEST(ConditionNumber, HagersEstimateIsALowerBoundWithinASmallFactorOfTheExact) {
 }
 
 namespace {
-// The step equations at tiny h: F is known only to its rounding, which moves the corrections by
-// `noise` (relative to z, above the step tolerance of 1e-12) whatever the iterate; the matrix is
-// ill-conditioned (cond ~ 1e6, as the beanie's Galerkin steps at h = 2e-5).
-struct NoisySolve {
-  StepReport report;
-  V3 z;
-  int jacobians = 0, residuals = 0;
-};
-
-// With `growth` (not 1) the noise is growth^k noise (1, 1, 1) at the k-th evaluation instead:
-// for growth = -1.5 each correction (the difference of two consecutive noises) is 1.5 times
-// the last.
-NoisySolve solve_noisy(const CubicSystem& sys, V3 z0, ChordMatrix<3>* chord, double noise, NewtonOptions opt,
-                       double growth = 1) {
-  NoisySolve out;
-  out.z = z0;
-  int calls = 0;
-  auto rounding = [&]() -> V3 {
-    ++calls;
-    if (growth != 1) return V3::Ones() * noise * std::pow(growth, calls);
-    return V3(std::sin(12.9898 * calls), std::cos(78.233 * calls), std::sin(3.7 * calls)) * noise;
-  };
-  out.report = newton_solve<3>(
-      7, opt,
-      [&](V3& F, M3& J) {
-        ++out.jacobians;
-        J = sys.J(out.z);
-        F = sys.F(out.z) + J * rounding().cwiseProduct(V3::Ones() + out.z.cwiseAbs());
-      },
-      [&](V3& F) {
-        ++out.residuals;
-        F = sys.F(out.z) + sys.J(out.z) * rounding().cwiseProduct(V3::Ones() + out.z.cwiseAbs());
-      },
-      [&](const V3& dz) { out.z += dz; }, [&] { return V3(out.z.cwiseAbs()); }, chord);
-  return out;
-}
-
+// Ill-conditioned (cond ~ 1e6, as the beanie's Galerkin steps at h = 2e-5).
 CubicSystem stiff_system() {
   CubicSystem s = base_system();
   s.A.row(0) *= 1e6;
@@ -209,7 +187,7 @@ TEST(NewtonChord, ChordStepsThatContractedThenStallAtTheNoiseAreConverged) {
   ASSERT_EQ(exact.report.status, StepStatus::Converged);
   NewtonOptions opt;
   opt.polish_chord = true;
-  const NoisySolve s = solve_noisy(next, a.z, &chord, 3e-11, opt);
+  const Solve s = solve(next, a.z, &chord, opt, 3e-11);
   ASSERT_EQ(s.report.status, StepStatus::Converged) << s.report.message;
   EXPECT_GT(chord.condition, 1e5);
   EXPECT_EQ(s.jacobians, 0);
@@ -230,7 +208,7 @@ TEST(NewtonChord, APolishStopsWhenItsCorrectionsStopShrinking) {
   next.b += V3(1e-3, -2e-9, 1e-9);
   NewtonOptions opt;
   opt.polish_chord = true;
-  const NoisySolve s = solve_noisy(next, a.z, &chord, 1e-13, opt, -1.5);
+  const Solve s = solve(next, a.z, &chord, opt, 1e-13, -1.5);
   ASSERT_EQ(s.report.status, StepStatus::Converged) << s.report.message;
   EXPECT_EQ(s.jacobians, 0);
   EXPECT_LE(s.residuals - s.report.iterations, 2) << "polish corrections after convergence";
