@@ -3,6 +3,7 @@
 // scale), with the parameter step adapted to the solver's success.
 #pragma once
 
+#include "galerkin_resample.hpp"
 #include "shooting.hpp"
 
 #include <functional>
@@ -42,31 +43,12 @@ ShootingGuess<P> resample(const ShootingResult<P>& from, int N) {
   return guess;
 }
 
-// The same on a Galerkin trajectory: node data interpolated linearly, increments rescaled to
-// the new step (X2, V1, O1 and bubbles are derivative-like: kept), W = exp(ratio log W_old),
-// multipliers interpolated.
+// The same on a Galerkin trajectory: the old curves restricted to the new intervals (refining) or
+// sampled at the new nodes (coarsening), multipliers interpolated (galerkin_resample.hpp).
 template <class C, int S, int Q>
-GalerkinGuess<Galerkin<C, S, Q>> resample(const ShootingResult<Galerkin<C, S, Q>>& from, int N) {
-  using Sch = Galerkin<C, S, Q>;
-  using G = typename Sch::Group;
-  const GalerkinTrajectory<Sch>& old = from.trajectory;
-  const double T = old.N() * old.h, h = T / N, ratio = h / old.h;
-  GalerkinGuess<Sch> guess;
-  GalerkinTrajectory<Sch>& tr = guess.trajectory;
-  tr.h = h;
-  tr.g0 = old.g0;
-  for (int n = 0; n < N; ++n) {
-    const double s = std::clamp(n * h / old.h, 0.0, double(old.N()));
-    const int i = std::min(static_cast<int>(s), old.N() - 1);
-    const double w = s - i;
-    Interval<Sch, double> iv = old.intervals[i];
-    iv.x = (1 - w) * old.x(i) + w * old.x(i + 1);
-    iv.v = (1 - w) * old.v(i) + w * old.v(i + 1);
-    iv.Om = (1 - w) * old.Omega(i) + w * old.Omega(i + 1);
-    if constexpr (Sch::d > 0)
-      iv.W = G::template exp<double>(typename G::template Tangent<double>(ratio * G::log(old.intervals[i].W)));
-    tr.intervals.push_back(iv);
-  }
+GalerkinGuess<Galerkin<C, S, Q>> resample(const C& model, const ShootingResult<Galerkin<C, S, Q>>& from, int N) {
+  GalerkinGuess<Galerkin<C, S, Q>> guess;
+  guess.trajectory = resample_trajectory(model, from.trajectory, N);
   return guess;
 }
 

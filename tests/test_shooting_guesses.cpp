@@ -3,6 +3,9 @@
 #include <lpshoot/problems/electron_bvp.hpp>
 #include <lpshoot/shooting/continuation.hpp>
 
+#include <algorithm>
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 using namespace lpshoot;
@@ -68,4 +71,116 @@ TEST(ShootingGuesses, ContinuationInThePotentialScaleReachesTheTarget) {
   for (int n = 0; n <= N; ++n) diff = std::max(diff, std::abs(again.trajectory.p[n](0) - cont.result.trajectory.p[n](0)));
   EXPECT_LT(diff, 1e-9);
   EXPECT_LE(again.iterations, 2);
+}
+
+namespace {
+// The interval data of the curve p(t) = Σ_k c_k t^k (degree ≤ 4) on [t, t + h], by Taylor:
+// X2 = Σ_{k≥2} p^(k) h^(k-2)/k!, V1 = Σ_{k≥2} p^(k) h^(k-2)/(k-1)!, bubble a = h² p''''/24.
+struct Quartic {
+  double c[5];
+  double d(int k, double t) const {  // k-th derivative
+    double s = 0;
+    for (int j = k; j <= 4; ++j) {
+      double f = 1;
+      for (int i = 0; i < k; ++i) f *= j - i;
+      s += f * c[j] * std::pow(t, j - k);
+    }
+    return s;
+  }
+  void interval(double t, double h, double& x, double& v, double& X2, double& V1, double& a) const {
+    x = d(0, t), v = d(1, t), X2 = V1 = 0;
+    double hk = 1, fact = 1;
+    for (int k = 2; k <= 4; ++k) {
+      fact *= k;
+      X2 += d(k, t) * hk / fact;
+      V1 += d(k, t) * hk * k / fact;
+      hk *= h;
+    }
+    a = h * h * d(4, t) / 24;
+  }
+};
+}  // namespace
+
+// Galerkin 6 carries quartics exactly: refined, every new interval's increments and bubble are
+// those of the same quartic on the new step (the bubble scales like h², the increments are not
+// the old interval's); coarsened, the nodes are the curve's.
+TEST(ShootingGuesses, GalerkinResampleCarriesAQuarticToAnyGrid) {
+  using Sch = ElectronGalerkin<4>;
+  const Quartic curve[3] = {{{0.3, -1.0, 0.7, 2.0, -1.5}}, {{-0.2, 0.5, -2.0, 0.4, 0.9}}, {{1.0, 0.0, 0.3, -0.8, 0.25}}};
+  const double T = 1.2;
+  auto trajectory = [&](int N) {
+    GalerkinTrajectory<Sch> tr;
+    tr.h = T / N;
+    tr.intervals.resize(N);
+    for (int n = 0; n < N; ++n) {
+      auto& iv = tr.intervals[n];
+      iv.w.setZero();
+      for (int a = 0; a < 3; ++a)
+        curve[a].interval(n * tr.h, tr.h, iv.x(a), iv.v(a), iv.X2(a), iv.V1(a), iv.w(Sch::shape_bubble(0) + a));
+    }
+    return tr;
+  };
+  const ElectronModel model;
+  const auto old = trajectory(6);
+  for (int N : {6, 18, 13}) {  // the same grid, three times finer, a non-nested finer grid
+    const auto fine = resample_trajectory(model, old, N);
+    const auto want = trajectory(N);
+    ASSERT_EQ(fine.N(), N);
+    double err = 0;
+    for (int n = 0; n < N; ++n) {
+      const auto &a = fine.intervals[n], &b = want.intervals[n];
+      err = std::max({err, (a.x - b.x).cwiseAbs().maxCoeff(), (a.v - b.v).cwiseAbs().maxCoeff(),
+                      (a.X2 - b.X2).cwiseAbs().maxCoeff(), (a.V1 - b.V1).cwiseAbs().maxCoeff(),
+                      (a.w - b.w).cwiseAbs().maxCoeff()});
+    }
+    EXPECT_LT(err, 1e-13) << "N = " << N;
+  }
+  const auto coarse = resample_trajectory(model, old, 4);  // h' = 1.5 h
+  const auto want = trajectory(4);
+  for (int n = 0; n <= 4; ++n) {
+    EXPECT_LT((coarse.x(n) - want.x(n)).cwiseAbs().maxCoeff(), 1e-13) << "node " << n;
+    EXPECT_LT((coarse.v(n) - want.v(n)).cwiseAbs().maxCoeff(), 1e-13) << "node " << n;
+  }
+}
+
+// Multipliers are densities: through the Gauss values, a polynomial of degree Q - 1 is exact.
+TEST(ShootingGuesses, GaussInterpolationIsExactOnPolynomialsOfDegreeQMinusOne) {
+  const auto& c = GalerkinTable<4, 3>::get().c;
+  double values[3];
+  auto f = [](double t) { return 0.4 - 1.3 * t + 2.2 * t * t; };
+  for (int i = 0; i < 3; ++i) values[i] = f(c[i]);
+  for (double t : {0.0, 0.25, 1.0, 1.7}) EXPECT_NEAR((detail::gauss_interpolate<4, 3>(values, 1, t)), f(t), 1e-13);
+}
+
+// A warm start from a coarser Galerkin 6 solve of the beanie: the group part is carried too
+// (g at the common nodes unchanged), the guess starts closer to the solution than the
+// interpolated one (measured: 68 times), saves a Newton iteration, and both reach the same solution.
+TEST(ShootingGuesses, GalerkinWarmStartOfTheBeanieStartsCloseAndReachesTheSameSolution) {
+  BeanieModel model;
+  model.par = {1.0, 1.0, 0.5, 1.0};
+  BeanieBoundary s = start_data(), e = end_data();
+  e.psi = 1.0;
+  ShootingOptions opt;
+  opt.method = ShootingMethod::Multiple;
+  opt.segments = 4;
+  const auto coarse_bvp = beanie_galerkin_bvp<4>(model, 2.0, 8, s, e);
+  const auto coarse = solve_bvp(coarse_bvp, beanie_galerkin_guess<4>(coarse_bvp, s, e), opt);
+  ASSERT_TRUE(coarse.ok()) << coarse.message;
+  const int N = 24;
+  const auto warm_guess = resample(model, coarse, N);
+  const auto g_old = coarse.trajectory.group(), g_new = warm_guess.trajectory.group();
+  for (int n = 0; n <= 8; ++n)
+    EXPECT_LT(SE2::log(SE2::compose(SE2::inverse(g_old[n]), g_new[3 * n])).cwiseAbs().maxCoeff(), 1e-12) << "node " << n;
+  const auto bvp = beanie_galerkin_bvp<4>(model, 2.0, N, s, e);
+  const auto cold = solve_bvp(bvp, beanie_galerkin_guess<4>(bvp, s, e), opt);
+  const auto warm = solve_bvp(bvp, warm_guess, opt);
+  ASSERT_TRUE(cold.ok()) << cold.message;
+  ASSERT_TRUE(warm.ok()) << warm.message;
+  std::printf("initial residual: interpolated guess %.3g, warm start %.3g (x tolerance); iterations %d, %d\n",
+              cold.residual_history.front(), warm.residual_history.front(), cold.iterations, warm.iterations);
+  EXPECT_LT(warm.residual_history.front(), 0.05 * cold.residual_history.front());
+  EXPECT_LT(warm.iterations, cold.iterations);
+  double diff = 0;
+  for (int n = 0; n <= N; ++n) diff = std::max(diff, (cold.trajectory.x(n) - warm.trajectory.x(n)).cwiseAbs().maxCoeff());
+  EXPECT_LT(diff, 1e-9);
 }
