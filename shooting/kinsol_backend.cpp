@@ -1,7 +1,9 @@
 // KINSOL backend: exact Newton (KINSetMaxSetupCalls(1): a fresh Jacobian every iteration; for an
 // affine F, SolverOptions::affine, one Jacobian for the full steps, whose Newton steps it gives) with
-// KLU, SUNDIALS' sparse direct solver (compressed sparse columns; fill-reducing ordering, partial
-// pivoting, refactorization on the same pattern), in two phases:
+// SUNDIALS' band LU when the system's pattern is banded (band_uses below: the shooting Jacobian,
+// block bidiagonal; no ordering step, partial pivoting within the band), else KLU, its sparse
+// direct solver (compressed sparse columns; fill-reducing ordering, partial pivoting), in two
+// phases:
 //  1. full Newton steps (KIN_NONE). The Newton step does not depend on how rows are scaled, but a
 //     line search's merit ½|F|² does, and shooting rows are scaled by their tolerances (spread
 //     1e4): a step that cuts the max-norm 30-fold can raise that merit 20-fold (rows exactly
@@ -20,7 +22,9 @@
 #include <kinsol/kinsol.h>
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
+#include <sunlinsol/sunlinsol_band.h>
 #include <sunlinsol/sunlinsol_klu.h>
+#include <sunmatrix/sunmatrix_band.h>
 #include <sunmatrix/sunmatrix_sparse.h>
 
 #include <algorithm>
@@ -38,6 +42,7 @@ struct KinsolData {
   Eigen::VectorXd x, F;
   SparseJacobian J;
   SUNLinearSolver LS = nullptr;  // to reset KLU's symbolic analysis when the pattern changes
+  bool band = false;             // SUNDIALS' band matrix and LU instead of KLU
   std::exception_ptr error;
   std::vector<double>* history = nullptr;
   const SolverOptions* options = nullptr;
@@ -181,6 +186,27 @@ void copy_to_sundials(const SparseJacobian& J, SUNMatrix Jm, SUNLinearSolver LS)
   std::copy(J.valuePtr(), J.valuePtr() + nnz, SUNSparseMatrix_Data(Jm));
 }
 
+// The same into a SUNDIALS band matrix (its bandwidths are the pattern's, fixed for the solve).
+void copy_to_band(const SparseJacobian& J, SUNMatrix Jm) {
+  const sunindextype ml = SUNBandMatrix_LowerBandwidth(Jm), mu = SUNBandMatrix_UpperBandwidth(Jm);
+  SUNMatZero(Jm);
+  for (int c = 0; c < J.outerSize(); ++c) {
+    sunrealtype* column = SUNBandMatrix_Column(Jm, c);  // at the diagonal
+    for (SparseJacobian::InnerIterator it(J, c); it; ++it) {
+      const sunindextype offset = it.row() - c;
+      if (offset > ml || -offset > mu) throw std::runtime_error("KINSOL: the Jacobian left the band it was set up with");
+      column[offset] = it.value();
+    }
+  }
+}
+
+// Band LU when its storage, (2 kl + ku + 1) n, is within 8 times the stored entries (as the rank
+// diagnosis, diagnostics.cpp): the electron at N = 10⁶ (kl 16, ku 9, 12 stored entries per
+// column) factors in ~40 ms where KLU's ordering, analysis and factorization took ~120 ms.
+bool band_uses(const NonlinearSystem::Pattern& p, int n) {
+  return p.kl >= 0 && p.ku >= 0 && static_cast<double>(2 * p.kl + p.ku + 1) * n <= 8.0 * static_cast<double>(p.nonzeros) + n;
+}
+
 int kin_jacobian(N_Vector u, N_Vector, SUNMatrix Jm, void* user, N_Vector, N_Vector) {
   auto* d = static_cast<KinsolData*>(user);
   try {
@@ -196,7 +222,10 @@ int kin_jacobian(N_Vector u, N_Vector, SUNMatrix Jm, void* user, N_Vector, N_Vec
     }
     d->fresh_jacobian = !chord;
     d->chord_taken = chord;
-    copy_to_sundials(d->J, Jm, d->LS);
+    if (d->band)
+      copy_to_band(d->J, Jm);
+    else
+      copy_to_sundials(d->J, Jm, d->LS);
     // KINSOL evaluates F at u before the Jacobian there: d->F is F(u).
     const double norm = d->F.lpNorm<Eigen::Infinity>();
     if (d->record_at_residuals && d->jacobians > 0) return 0;  // recorded at the residuals (a refresh)
@@ -259,12 +288,22 @@ int kinsol_run(KinsolData& data, Eigen::VectorXd& x, const SolverOptions& opt, i
   k.scale = N_VNew_Serial(n, k.ctx);
   view(k.u) = x;
   N_VConst(1.0, k.scale);
-  // An empty pattern: the first Jacobian sets it (copy_to_sundials).
-  k.J = SUNSparseMatrix(n, n, std::max(1, n), CSC_MAT, k.ctx);
-  std::fill(SUNSparseMatrix_IndexPointers(k.J), SUNSparseMatrix_IndexPointers(k.J) + n + 1, sunindextype(0));
-  k.LS = SUNLinSol_KLU(k.u, k.J, k.ctx);
-  if (!k.J || !k.LS) throw std::runtime_error("KINSOL: cannot create the sparse linear solver");
-  SUNLinSol_KLUGetCommon(k.LS)->tol = 1.0;  // strict partial pivoting (KLU's default 0.001 prefers the diagonal)
+  const NonlinearSystem::Pattern pattern = data.system->pattern();
+  data.band = opt.linear_solver == LinearSolver::Band ||
+              (opt.linear_solver == LinearSolver::Auto && band_uses(pattern, n));
+  if (data.band) {
+    if (pattern.kl < 0) throw std::invalid_argument("the band linear solver needs the Jacobian's bandwidths");
+    k.J = SUNBandMatrix(n, std::min(pattern.ku, n - 1), std::min(pattern.kl, n - 1), k.ctx);
+    k.LS = k.J ? SUNLinSol_Band(k.u, k.J, k.ctx) : nullptr;
+    if (!k.J || !k.LS) throw std::runtime_error("KINSOL: cannot create the band linear solver");
+  } else {
+    // An empty pattern: the first Jacobian sets it (copy_to_sundials).
+    k.J = SUNSparseMatrix(n, n, std::max(1, n), CSC_MAT, k.ctx);
+    if (k.J) std::fill(SUNSparseMatrix_IndexPointers(k.J), SUNSparseMatrix_IndexPointers(k.J) + n + 1, sunindextype(0));
+    k.LS = k.J ? SUNLinSol_KLU(k.u, k.J, k.ctx) : nullptr;
+    if (!k.J || !k.LS) throw std::runtime_error("KINSOL: cannot create the sparse linear solver");
+    SUNLinSol_KLUGetCommon(k.LS)->tol = 1.0;  // strict partial pivoting (KLU's default 0.001 prefers the diagonal)
+  }
   data.LS = k.LS;
   k.mem = KINCreate(k.ctx);
   KINInit(k.mem, kin_residual, k.u);

@@ -36,9 +36,20 @@ class NonlinearSystem {
   // one sweep (shooting: one flow with sensitivities instead of one without, then one with) may
   // compute it with the residual. Ignored by default.
   virtual void expect_jacobian(bool) {}
+  // The Jacobian's pattern as known before the solve (its lower and upper bandwidths and stored
+  // entries), for the choice of a band or a sparse factorization; kl < 0: unknown.
+  struct Pattern {
+    int kl = -1, ku = -1;
+    long nonzeros = 0;
+  };
+  virtual Pattern pattern() const { return {}; }
 };
 
 enum class Backend { Kinsol, Nlopt };
+
+// KINSOL's linear solver: Auto takes the band LU for a banded pattern (NonlinearSystem::pattern),
+// else KLU; Band and Klu force one (Band needs the pattern).
+enum class LinearSolver { Auto, Band, Klu };
 
 struct SolverOptions {
   Backend backend = Backend::Kinsol;
@@ -51,6 +62,7 @@ struct SolverOptions {
   // Lagrangian is quadratic and constraints linear, core/degree.hpp). KINSOL then factors the
   // Jacobian once, and its later full Newton steps, on that factorization, are exact Newton steps.
   bool affine = false;
+  LinearSolver linear_solver = LinearSolver::Auto;
 };
 
 enum class SolverStatus { Converged, NotConverged, Failed };

@@ -11,6 +11,7 @@
 // propagated in parallel.
 #pragma once
 
+#include "band_lu.hpp"
 #include "nonlinear_solver.hpp"
 #include "scheme_galerkin.hpp"
 #include "scheme_nodal.hpp"
@@ -108,6 +109,13 @@ class ShootingSystem : public NonlinearSystem {
   // (kinsol_backend.cpp) (for diagnostics that need no exact
   // point: the rank and condition there are those of the solution to the digits reported).
   const SparseJacobian& last_jacobian() const { return last_J_; }
+  // From the last Jacobian (the solve evaluates one at the guess first): the pattern is the same
+  // at every evaluation (write_block_columns).
+  Pattern pattern() const override {
+    if (last_J_.rows() != size()) return {};
+    const auto [kl, ku] = BandLU::bandwidths(last_J_);
+    return {kl, ku, static_cast<long>(last_J_.nonZeros())};
+  }
   const Eigen::VectorXd& last_jacobian_point() const { return last_J_x_; }
   void set_row_scaling(const Eigen::VectorXd& w) { w_ = w; }
   // The Jacobian at the next residual's point is computed with it (one seeded sweep) and kept.
