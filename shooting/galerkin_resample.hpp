@@ -24,6 +24,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace lpshoot {
 namespace detail {
@@ -88,6 +90,8 @@ GalerkinTrajectory<Sch> resample_trajectory(const typename Sch::Model& model, co
   using G = typename Sch::Group;
   constexpr int r = Sch::r, d = Sch::d, m = Sch::m, S = Sch::degree, Q = Sch::gauss, nb = Sch::bubbles;
   const int No = old.N();
+  if (No < 1 || !(old.h > 0)) throw std::invalid_argument("resample: the trajectory to carry has no intervals");
+  if (N < 1) throw std::invalid_argument("resample: N = " + std::to_string(N) + " intervals requested");
   const double H = old.h, T = No * H, h = T / N, rho = h / H;
   GalerkinTrajectory<Sch> tr;
   tr.h = h;

@@ -135,6 +135,8 @@ TEST(ShootingGuesses, GalerkinResampleCarriesAQuarticToAnyGrid) {
     }
     EXPECT_LT(err, 1e-13) << "N = " << N;
   }
+  EXPECT_THROW(resample_trajectory(model, old, 0), std::invalid_argument);
+  EXPECT_THROW(resample_trajectory(model, GalerkinTrajectory<Sch>{}, 4), std::invalid_argument);
   const auto coarse = resample_trajectory(model, old, 4);  // h' = 1.5 h
   const auto want = trajectory(4);
   for (int n = 0; n <= 4; ++n) {
