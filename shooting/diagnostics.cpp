@@ -113,12 +113,10 @@ RankDiagnosis diagnose_rank(Eigen::SparseMatrix<double, Eigen::ColMajor, int> J,
   out.condition = INFINITY;
   double inverse_norm1 = INFINITY;
   // A banded J (the shooting Jacobian: block bidiagonal with boundary rows) is factored in band
-  // storage (band_lu.hpp: O(n kl (kl + ku)), no ordering step) when that storage is within 8
-  // times the nonzeros; a wider pattern by sparse LU. (The Galerkin electron's J has exact zeros,
-  // pruned above: 7.9 nonzeros per column in a band of 2 kl + ku + 1 = 42 at N = 10⁶; the band
-  // LU and estimate take 47 ms there, the sparse LU 90 ms.)
+  // storage (band_lu.hpp: O(n kl (kl + ku)), no ordering step) when BandLU::pays; a wider
+  // pattern by sparse LU.
   const auto [kl, ku] = BandLU::bandwidths(J);
-  if (static_cast<double>(2 * kl + ku + 1) * n <= 8.0 * static_cast<double>(J.nonZeros()) + n) {
+  if (BandLU::pays(n, kl, ku, static_cast<long>(J.nonZeros()))) {
     const BandLU lu(J, kl, ku);
     if (lu.ok())
       inverse_norm1 = inverse_one_norm_estimate<Eigen::VectorXd>([&](const Eigen::VectorXd& b) { return lu.solve(b); },

@@ -107,13 +107,19 @@ GalerkinTrajectory<Sch> resample_trajectory(const typename Sch::Model& model, co
     tau = s - i;
   };
   using Tangent = typename G::template Tangent<double>;
+  // The group curve's increments in the shape curve's form (see the file comment).
+  auto group_increments = [H](const auto& e, int a, double& Z2, double& Z1) {
+    Z2 = (e.zeta(a) - H * e.omega0(a)) / (H * H);
+    Z1 = (e.omega1(a) - e.omega0(a)) / H;
+  };
   // The old group curve of interval i: ξ and dξ/dt at τ, from its ends and bubbles.
   auto group_curve = [&](int i, double tau, Tangent& xi, Tangent& dxi) {
     if constexpr (d > 0) {
       const auto& iv = old.intervals[i];
       const auto e = group_curve_ends(model, iv, H);
       for (int a = 0; a < d; ++a) {
-        const double Z2 = (e.zeta(a) - H * e.omega0(a)) / (H * H), Z1 = (e.omega1(a) - e.omega0(a)) / H;
+        double Z2, Z1;
+        group_increments(e, a, Z2, Z1);
         detail::curve_at<S>(0.0, e.omega0(a), Z2, Z1, iv.w.data() + Sch::group_bubble(0) + a, d, H, tau, xi(a), dxi(a));
       }
     }
@@ -164,8 +170,8 @@ GalerkinTrajectory<Sch> resample_trajectory(const typename Sch::Model& model, co
       if (rho <= 1 && nb > 0) {
         const auto e = group_curve_ends(model, ov, H);
         for (int a = 0; a < d; ++a) {
-          const double Z2 = (e.zeta(a) - H * e.omega0(a)) / (H * H), Z1 = (e.omega1(a) - e.omega0(a)) / H;
-          double Z2n, Z1n;
+          double Z2, Z1, Z2n, Z1n;
+          group_increments(e, a, Z2, Z1);
           detail::restrict_increments<S>(Z2, Z1, ov.w.data() + Sch::group_bubble(0) + a, d, tau0, rho, Z2n, Z1n,
                                          iv.w.data() + Sch::group_bubble(0) + a);
         }

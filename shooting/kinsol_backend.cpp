@@ -1,6 +1,6 @@
 // KINSOL backend: exact Newton (KINSetMaxSetupCalls(1): a fresh Jacobian every iteration; for an
 // affine F, SolverOptions::affine, one Jacobian for the full steps, whose Newton steps it gives) with
-// SUNDIALS' band LU when the system's pattern is banded (band_uses below: the shooting Jacobian,
+// SUNDIALS' band LU when the system's pattern is banded (BandLU::pays: the shooting Jacobian,
 // block bidiagonal; no ordering step, partial pivoting within the band), else KLU, its sparse
 // direct solver (compressed sparse columns; fill-reducing ordering, partial pivoting), in two
 // phases:
@@ -17,6 +17,7 @@
 //  2. if full steps diverge (the unscaled residual, NonlinearSystem::progress_norm, above 10x
 //     the start's, or F not evaluable) or do not converge: KIN_LINESEARCH from the best iterate.
 // Exceptions never cross the C frames: they are stored and rethrown after KINSol returns.
+#include "band_lu.hpp"
 #include "nonlinear_solver.hpp"
 
 #include <kinsol/kinsol.h>
@@ -200,13 +201,6 @@ void copy_to_band(const SparseJacobian& J, SUNMatrix Jm) {
   }
 }
 
-// Band LU when its storage, (2 kl + ku + 1) n, is within 8 times the stored entries (as the rank
-// diagnosis, diagnostics.cpp): the electron at N = 10⁶ (kl 16, ku 9, 12 stored entries per
-// column) factors in ~40 ms where KLU's ordering, analysis and factorization took ~120 ms.
-bool band_uses(const NonlinearSystem::Pattern& p, int n) {
-  return p.kl >= 0 && p.ku >= 0 && static_cast<double>(2 * p.kl + p.ku + 1) * n <= 8.0 * static_cast<double>(p.nonzeros) + n;
-}
-
 int kin_jacobian(N_Vector u, N_Vector, SUNMatrix Jm, void* user, N_Vector, N_Vector) {
   auto* d = static_cast<KinsolData*>(user);
   try {
@@ -290,7 +284,7 @@ int kinsol_run(KinsolData& data, Eigen::VectorXd& x, const SolverOptions& opt, i
   N_VConst(1.0, k.scale);
   const NonlinearSystem::Pattern pattern = data.system->pattern();
   data.band = opt.linear_solver == LinearSolver::Band ||
-              (opt.linear_solver == LinearSolver::Auto && band_uses(pattern, n));
+              (opt.linear_solver == LinearSolver::Auto && BandLU::pays(n, pattern.kl, pattern.ku, pattern.nonzeros));
   if (data.band) {
     if (pattern.kl < 0) throw std::invalid_argument("the band linear solver needs the Jacobian's bandwidths");
     k.J = SUNBandMatrix(n, std::min(pattern.ku, n - 1), std::min(pattern.kl, n - 1), k.ctx);
