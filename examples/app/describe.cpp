@@ -30,14 +30,6 @@ std::string range_text(const ParameterSpec& p) {
   return "in " + std::string(p.min_exclusive ? "(" : "[") + number(p.min) + ", " + number(p.max) + "]";
 }
 
-std::vector<std::string> schemes(const ProblemDescriptor& d) {
-  if (!d.optimal_control) return {"paper"};  // a free motion: the paper's windows only
-  std::vector<std::string> s;
-  if (d.paper_order > 0) s.push_back("paper");
-  s.push_back("galerkin4");
-  s.push_back("galerkin6");
-  return s;
-}
 
 json describe(const ProblemDescriptor& d) {
   json j;
@@ -65,7 +57,7 @@ json describe(const ProblemDescriptor& d) {
   j["command"] = d.optimal_control ? "solve" : "simulate";
   if (!d.optimal_control) j["configuration"] = d.configuration;
   j["columns"] = {{"shape", d.shape}, {"velocity", d.velocity}, {"group", d.group}, {"omega", d.omega}, {"outputs", d.outputs}};
-  j["schemes"] = schemes(d);
+  j["schemes"] = scheme_names(d);
   if (d.paper_order > 0) j["paper_order"] = d.paper_order;
   return j;
 }
@@ -84,7 +76,7 @@ std::string problems_text(const std::vector<const Problem*>& problems) {
     const ProblemDescriptor& d = p->descriptor();
     out += d.name + ": " + d.summary + "\n";
     std::string sc;
-    for (const auto& s : schemes(d)) sc += (sc.empty() ? "" : ", ") + s;
+    for (const auto& s : scheme_names(d)) sc += (sc.empty() ? "" : ", ") + s;
     out += "  " + std::string(d.optimal_control ? "solve" : "simulate") + ", schemes: " + sc + "\n";
     if (!d.parameters.empty()) out += "  parameters:\n";
     for (const auto& q : d.parameters) {

@@ -86,6 +86,8 @@ struct ProblemDescriptor {
   // 0 when the problem has only the continuous form (Galerkin schemes only).
   int paper_order = 0;
   std::vector<SchemeOption> paper_options;
+  // The highest Galerkin order compiled in: 6, or 8 (ModelProblem<Model, 8> sets it).
+  int galerkin_max_order = 6;
   // false: a free motion from initial data (`lpshoot simulate`, the paper's windows of order
   // paper_order) rather than an optimal control problem (`lpshoot solve`).
   bool optimal_control = true;

@@ -1,7 +1,7 @@
 // lpshoot: the command-line application (CLI11 stays in this file).
 //   lpshoot solve SCENE.json [--out DIR] [--set key.path=value ...]
 //   lpshoot simulate SCENE.json [...]
-//   lpshoot sweep SCENE.json --N 50,100,200 [--scheme paper,galerkin4,galerkin6] [--method single,multiple]
+//   lpshoot sweep SCENE.json --N 50,100,200 [--scheme paper,galerkin4,galerkin6,galerkin8] [--method single,multiple]
 //                [--backend kinsol,nlopt]
 //   lpshoot check SCENE.json
 //   lpshoot problems [--json]
@@ -218,9 +218,9 @@ int run_command(int argc, char** argv) {
   int steps_per_segment = 0;
   std::string reference = "auto";
   sweep->add_option("--N", grids, "grids, comma separated (e.g. 50,100,200,400)")->required()->delimiter(',');
-  sweep->add_option("--scheme", schemes, "discretizations to compare (paper,galerkin4,galerkin6)")
+  sweep->add_option("--scheme", schemes, "discretizations to compare (paper,galerkin4,galerkin6,galerkin8)")
       ->delimiter(',')
-      ->check(CLI::IsMember({"paper", "galerkin4", "galerkin6"}));
+      ->check(CLI::IsMember({"paper", "galerkin4", "galerkin6", "galerkin8"}));
   sweep->add_option("--method", methods, "shooting methods to compare (single,multiple)")
       ->delimiter(',')
       ->check(CLI::IsMember({"single", "multiple"}));

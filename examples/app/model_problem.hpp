@@ -1,11 +1,15 @@
 // A problem given by its continuous model (core/continuous.hpp: ℓ, constraints χ, connection)
 // and a descriptor: everything the application does with it on the Galerkin schemes of order 4
-// and 6 (METHOD.md §9) — boundary conditions from the scene, a guess, the solve, the columns,
+// and 6, and 8 with MaxOrder = 8 (METHOD.md §9) — boundary conditions from the scene, a guess, the solve, the columns,
 // the momentum — with nothing written per problem. A problem with a discrete form too (the
 // paper's windows) derives from it and overrides solve_paper and check_paper.
 //
 //   const ModelProblem<MyModel> my_problem(my_descriptor(), [](const ParameterValues& v) { ... });
 //   LPSHOOT_REGISTER_PROBLEM(my_problem);
+//
+// Each order is a compiled instance of the whole solve; order 8 (quintic, 4 Gauss points) costs
+// about half as much compile time again, so it is opt-in: ModelProblem<MyModel, 8>. The scene
+// reader rejects scheme.order 8 for a problem compiled without it, naming the key.
 #pragma once
 
 #include "group_coordinates.hpp"
@@ -17,8 +21,10 @@
 
 namespace lpshoot::app {
 
-template <class Model>
+template <class Model, int MaxOrder = 6>
 class ModelProblem : public Problem {
+  static_assert(MaxOrder == 6 || MaxOrder == 8, "ModelProblem: the highest Galerkin order compiled in is 6 or 8");
+
  public:
   using G = typename Model::Group;
   using Element = typename G::template Element<double>;
@@ -30,6 +36,7 @@ class ModelProblem : public Problem {
 
   ModelProblem(ProblemDescriptor descriptor, std::function<Model(const ParameterValues&)> make)
       : descriptor_(std::move(descriptor)), make_(std::move(make)) {
+    descriptor_.galerkin_max_order = MaxOrder;
     const ProblemDescriptor& D = descriptor_;
     if (static_cast<int>(D.shape.size()) != r || static_cast<int>(D.velocity.size()) != r ||
         static_cast<int>(D.group.size()) != d || static_cast<int>(D.omega.size()) != d)
@@ -62,12 +69,19 @@ class ModelProblem : public Problem {
   // Optional: problem-specific guesses; without them, default_guess.
   GuessFunction<3> guess4;
   GuessFunction<4> guess6;
+  GuessFunction<5> guess8;  // used with MaxOrder = 8
 
   const ProblemDescriptor& descriptor() const override { return descriptor_; }
   Model model(const Scene& s) const { return make_(s.parameters); }
 
   RunRecord solve(const Scene& s, const Progress& progress) const override {
     if (!s.galerkin()) return solve_paper(s, progress);
+    if constexpr (MaxOrder >= 8) {
+      if (s.galerkin_order == 8) return solve_galerkin<5>(s, progress);
+    }
+    if (s.galerkin_order != 4 && s.galerkin_order != 6)  // the scene reader rejects it first
+      throw SceneError(s.file + ": scheme.order: " + std::to_string(s.galerkin_order) + " is not compiled into problem \"" +
+                       descriptor_.name + "\"");
     return s.galerkin_order == 6 ? solve_galerkin<4>(s, progress) : solve_galerkin<3>(s, progress);
   }
 
@@ -191,6 +205,8 @@ class ModelProblem : public Problem {
       if (guess4) return guess4(bvp, s);
     } else if constexpr (S == 4) {
       if (guess6) return guess6(bvp, s);
+    } else if constexpr (S == 5) {
+      if (guess8) return guess8(bvp, s);
     }
     return default_guess<S>(bvp, s);
   }
@@ -222,9 +238,9 @@ double momentum_table(const std::vector<Vec<double, d>>& J, int N, const std::st
   return worst;
 }
 
-template <class Model>
+template <class Model, int MaxOrder>
 template <int S>
-RunRecord ModelProblem<Model>::solve_galerkin(const Scene& s, const Progress& progress) const {
+RunRecord ModelProblem<Model, MaxOrder>::solve_galerkin(const Scene& s, const Progress& progress) const {
   using Sch = Scheme<S>;
   const ProblemDescriptor& D = descriptor_;
   RunRecord rec = start_record("solve", s);

@@ -40,7 +40,7 @@ const ProblemDescriptor& beanie_descriptor() {
 
 namespace {
 
-class BeanieProblem : public ModelProblem<problems::BeanieModel> {
+class BeanieProblem : public ModelProblem<problems::BeanieModel, 8> {
  public:
   BeanieProblem()
       : ModelProblem(beanie_descriptor(), [](const ParameterValues& v) { return problems::BeanieModel{beanie_parameters(v)}; }) {
@@ -60,6 +60,9 @@ class BeanieProblem : public ModelProblem<problems::BeanieModel> {
     };
     guess6 = [](const GalerkinBVP<Scheme<4>>& bvp, const Scene& s) {
       return problems::beanie_galerkin_guess<4>(bvp, beanie_boundary(s.start), beanie_boundary(s.end));
+    };
+    guess8 = [](const GalerkinBVP<Scheme<5>>& bvp, const Scene& s) {
+      return problems::beanie_galerkin_guess<5>(bvp, beanie_boundary(s.start), beanie_boundary(s.end));
     };
   }
   std::optional<std::pair<std::string, std::string>> check_parameters(const ParameterValues& v) const override {

@@ -26,7 +26,7 @@ ProblemDescriptor electron_descriptor() {
   return d;
 }
 
-class ElectronProblem : public ModelProblem<problems::ElectronModel> {
+class ElectronProblem : public ModelProblem<problems::ElectronModel, 8> {
  public:
   ElectronProblem()
       : ModelProblem(electron_descriptor(), [](const ParameterValues& v) { return problems::model_of(electron_of(v)); }) {
@@ -39,6 +39,9 @@ class ElectronProblem : public ModelProblem<problems::ElectronModel> {
     };
     guess6 = [](const GalerkinBVP<Scheme<4>>& bvp, const Scene& s) {
       return problems::electron_galerkin_guess<4>(bvp, electron_boundary(s.start), electron_boundary(s.end));
+    };
+    guess8 = [](const GalerkinBVP<Scheme<5>>& bvp, const Scene& s) {
+      return problems::electron_galerkin_guess<5>(bvp, electron_boundary(s.start), electron_boundary(s.end));
     };
   }
   ExactReference exact_reference(const Scene& s, const std::vector<double>& times) const override {

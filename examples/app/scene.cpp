@@ -585,8 +585,14 @@ void read_scheme(const Reader& sc, Scene& s) {
                 "and the continuous constraints at its Gauss points); remove it",
                 key);
     s.galerkin_order = sc.integer("order", 4);
-    if (s.galerkin_order != 4 && s.galerkin_order != 6)
-      sc.fail("must be 4 or 6 (cubic or quartic Galerkin; got " + std::to_string(s.galerkin_order) + ")", "order");
+    if (s.galerkin_order != 4 && s.galerkin_order != 6 && s.galerkin_order != 8)
+      sc.fail("must be 4, 6 or 8 (cubic, quartic or quintic Galerkin; got " + std::to_string(s.galerkin_order) + ")",
+              "order");
+    if (s.galerkin_order > d.galerkin_max_order)
+      sc.fail("order " + std::to_string(s.galerkin_order) + " is not compiled into problem \"" + d.name +
+                  "\" (its highest is " + std::to_string(d.galerkin_max_order) +
+                  "; a problem of one's own gets order 8 as ModelProblem<Model, 8>)",
+              "order");
     return;
   }
   if (sc.has("order"))
@@ -693,13 +699,22 @@ std::string resource_problem(const Scene& s) {
   return buf;
 }
 
+std::vector<std::string> scheme_names(const ProblemDescriptor& d) {
+  if (!d.optimal_control) return {"paper"};  // a free motion: the paper's windows only
+  std::vector<std::string> s;
+  if (d.paper_order > 0) s.push_back("paper");
+  for (int order = 4; order <= d.galerkin_max_order; order += 2) s.push_back("galerkin" + std::to_string(order));
+  return s;
+}
+
 bool set_scheme(Scene& s, const std::string& name) {
   if (name == "paper") {
     s.discretization = Discretization::Paper;
     return true;
   }
-  for (int order : {4, 6})
+  for (int order : {4, 6, 8})
     if (name == "galerkin" + std::to_string(order)) {
+      if (s.problem && order > s.problem->descriptor().galerkin_max_order) return false;
       s.discretization = Discretization::Galerkin;
       s.galerkin_order = order;
       return true;

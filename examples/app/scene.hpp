@@ -26,7 +26,7 @@ struct SceneError : std::runtime_error {
 class Problem;  // problem.hpp
 
 // scheme.discretization: the paper's nodal windows (with a closure), or Galerkin on node states
-// of order 4 or 6 (METHOD.md §9; the library has order 8 too).
+// of order 4, 6 or 8 (METHOD.md §9; 8 where the problem compiles it in, ModelProblem<Model, 8>).
 enum class Discretization { Paper, Galerkin };
 
 // A free motion's initial data (descriptor.configuration names the components): q_0, q_1
@@ -46,7 +46,7 @@ struct Scene {
   int N = 100;
 
   Discretization discretization = Discretization::Paper;
-  int galerkin_order = 4;  // scheme.order (Galerkin only): 4 or 6
+  int galerkin_order = 4;  // scheme.order (Galerkin only): 4, 6 or 8
   Closure closure = Closure::SecondOrder;
   std::map<std::string, std::string> scheme_options;  // the problem's own paper-scheme choices (descriptor)
   ShootingOptions shooting;
@@ -88,7 +88,12 @@ struct Scene {
 // memory), or "". Checked when a scene is read and for every grid of a sweep.
 std::string resource_problem(const Scene& s);
 
-// Sets the scheme from a name scheme_name() gives; false for an unknown name.
+// The schemes a problem has, by the names scheme_name() gives: "paper" (with a discrete form),
+// "galerkin4", "galerkin6", and "galerkin8" when compiled in; a free motion has "paper" only.
+std::vector<std::string> scheme_names(const ProblemDescriptor& d);
+
+// Sets the scheme from a name scheme_name() gives; false for an unknown name or one the scene's
+// problem does not have (a Galerkin order not compiled into it).
 bool set_scheme(Scene& s, const std::string& name);
 
 // Reads, applies the --set overrides ("key.path=value", value parsed as JSON when it is JSON,

@@ -1,5 +1,7 @@
 #include "sweep.hpp"
 
+#include "problem.hpp"
+
 #include <algorithm>
 #include <cstdio>
 
@@ -47,12 +49,13 @@ SweepRecord run_sweep(const Scene& scene, const std::string& command, const Swee
   std::vector<Scene> schemes;
   for (const std::string& name : opt.schemes) {
     Scene sc = scene;
-    const bool has_paper = scene.order() > 0;  // a problem with only a continuous form has Galerkin schemes only
-    if (!scene.is_optimal_control() || !set_scheme(sc, name) || (name == "paper" && !has_paper))
+    const std::vector<std::string> names = scheme_names(scene.problem->descriptor());
+    if (!scene.is_optimal_control() || std::find(names.begin(), names.end(), name) == names.end() || !set_scheme(sc, name)) {
+      std::string list;
+      for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
       throw SceneError("--scheme: '" + name + "' is not a scheme of " + scene.problem_name +
-                       (!scene.is_optimal_control() ? " (a simulation has one scheme)"
-                        : has_paper                 ? " (paper, galerkin4, galerkin6)"
-                                                    : " (galerkin4, galerkin6)"));
+                       (!scene.is_optimal_control() ? " (a simulation has one scheme)" : " (" + list + ")"));
+    }
     schemes.push_back(sc);
   }
   if (schemes.empty()) schemes.push_back(scene);

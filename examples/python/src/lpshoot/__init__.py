@@ -166,7 +166,7 @@ def simulate(scene, overrides=None, /, *, progress=None, **more):
 def sweep(scene, N, overrides=None, /, *, schemes=(), methods=(), backends=(), steps_per_segment=0,
           reference="auto", progress=None, **more):
     """Solves (or simulates) the scene on the grids ``N`` and, optionally, several schemes
-    ("paper", "galerkin4", "galerkin6"), methods ("single", "multiple") and backends ("kinsol",
+    ("paper", "galerkin4", "galerkin6", "galerkin8"), methods ("single", "multiple") and backends ("kinsol",
     "nlopt"); errors against the exact solution ("auto", where the problem has one) or the finest
     grid ("finest"). Returns a :class:`SweepResult`."""
     if reference not in ("auto", "finest"):
