@@ -74,39 +74,47 @@ TEST(ShootingGuesses, ContinuationInThePotentialScaleReachesTheTarget) {
 }
 
 namespace {
-// The interval data of the curve p(t) = Σ_k c_k t^k (degree ≤ 4) on [t, t + h], by Taylor:
-// X2 = Σ_{k≥2} p^(k) h^(k-2)/k!, V1 = Σ_{k≥2} p^(k) h^(k-2)/(k-1)!, bubble a = h² p''''/24.
-struct Quartic {
-  double c[5];
+// The interval data of the curve p(t) = Σ_k c_k t^k (degree ≤ 5) on [t, t + h], by Taylor:
+// X2 = Σ_{k≥2} p^(k) h^(k-2)/k!, V1 = Σ_{k≥2} p^(k) h^(k-2)/(k-1)!; the bubbles from the curve's
+// τ⁴ and τ⁵ coefficients C4 = h⁴ p/24, C5 = h⁵ p'/120 on the bubbles h² a_j β_j,
+// β_0 = τ²(1-τ)² = τ² - 2τ³ + τ⁴ and β_1 = β_0 (2τ - 1) = -τ² + 4τ³ - 5τ⁴ + 2τ⁵ (the rest is the
+// Hermite cubic): a_1 = C5 / (2h²), a_0 = (C4 + 5 C5 / 2) / h².
+struct Quintic {
+  double c[6];
   double d(int k, double t) const {  // k-th derivative
     double s = 0;
-    for (int j = k; j <= 4; ++j) {
+    for (int j = k; j <= 5; ++j) {
       double f = 1;
       for (int i = 0; i < k; ++i) f *= j - i;
       s += f * c[j] * std::pow(t, j - k);
     }
     return s;
   }
-  void interval(double t, double h, double& x, double& v, double& X2, double& V1, double& a) const {
+  void interval(double t, double h, double& x, double& v, double& X2, double& V1, double a[2]) const {
     x = d(0, t), v = d(1, t), X2 = V1 = 0;
     double hk = 1, fact = 1;
-    for (int k = 2; k <= 4; ++k) {
+    for (int k = 2; k <= 5; ++k) {
       fact *= k;
       X2 += d(k, t) * hk / fact;
       V1 += d(k, t) * hk * k / fact;
       hk *= h;
     }
-    a = h * h * d(4, t) / 24;
+    const double C4 = std::pow(h, 4) * d(4, t) / 24, C5 = std::pow(h, 5) * d(5, t) / 120;
+    a[0] = (C4 + 2.5 * C5) / (h * h);
+    a[1] = C5 / (2 * h * h);
   }
 };
-}  // namespace
 
-// Galerkin 6 carries quartics exactly: refined, every new interval's increments and bubble are
-// those of the same quartic on the new step (the bubble scales like h², the increments are not
-// the old interval's); coarsened, the nodes are the curve's.
-TEST(ShootingGuesses, GalerkinResampleCarriesAQuarticToAnyGrid) {
-  using Sch = ElectronGalerkin<4>;
-  const Quartic curve[3] = {{{0.3, -1.0, 0.7, 2.0, -1.5}}, {{-0.2, 0.5, -2.0, 0.4, 0.9}}, {{1.0, 0.0, 0.3, -0.8, 0.25}}};
+// Galerkin of degree S carries polynomials of degree S exactly: refined, every new interval's
+// increments and bubbles are those of the same curve on the new step (the bubbles scale like h²,
+// the increments are not the old interval's); coarsened, the nodes are the curve's.
+template <int S>
+void check_resample_carries_polynomials() {
+  using Sch = ElectronGalerkin<S>;
+  const double top = S == 5 ? 1.0 : 0.0;  // the degree-5 coefficients
+  const Quintic curve[3] = {{{0.3, -1.0, 0.7, 2.0, -1.5, 0.8 * top}},
+                            {{-0.2, 0.5, -2.0, 0.4, 0.9, -1.1 * top}},
+                            {{1.0, 0.0, 0.3, -0.8, 0.25, 0.6 * top}}};
   const double T = 1.2;
   auto trajectory = [&](int N) {
     GalerkinTrajectory<Sch> tr;
@@ -115,8 +123,11 @@ TEST(ShootingGuesses, GalerkinResampleCarriesAQuarticToAnyGrid) {
     for (int n = 0; n < N; ++n) {
       auto& iv = tr.intervals[n];
       iv.w.setZero();
-      for (int a = 0; a < 3; ++a)
-        curve[a].interval(n * tr.h, tr.h, iv.x(a), iv.v(a), iv.X2(a), iv.V1(a), iv.w(Sch::shape_bubble(0) + a));
+      for (int a = 0; a < 3; ++a) {
+        double bubble[2];
+        curve[a].interval(n * tr.h, tr.h, iv.x(a), iv.v(a), iv.X2(a), iv.V1(a), bubble);
+        for (int j = 0; j < Sch::bubbles; ++j) iv.w(Sch::shape_bubble(j) + a) = bubble[j];
+      }
     }
     return tr;
   };
@@ -133,7 +144,7 @@ TEST(ShootingGuesses, GalerkinResampleCarriesAQuarticToAnyGrid) {
                       (a.X2 - b.X2).cwiseAbs().maxCoeff(), (a.V1 - b.V1).cwiseAbs().maxCoeff(),
                       (a.w - b.w).cwiseAbs().maxCoeff()});
     }
-    EXPECT_LT(err, 1e-13) << "N = " << N;
+    EXPECT_LT(err, 1e-13) << "degree " << S << ", N = " << N;
   }
   EXPECT_THROW(resample_trajectory(model, old, 0), std::invalid_argument);
   EXPECT_THROW(resample_trajectory(model, GalerkinTrajectory<Sch>{}, 4), std::invalid_argument);
@@ -144,6 +155,10 @@ TEST(ShootingGuesses, GalerkinResampleCarriesAQuarticToAnyGrid) {
     EXPECT_LT((coarse.v(n) - want.v(n)).cwiseAbs().maxCoeff(), 1e-13) << "node " << n;
   }
 }
+}  // namespace
+
+TEST(ShootingGuesses, GalerkinResampleCarriesAQuarticToAnyGrid) { check_resample_carries_polynomials<4>(); }
+TEST(ShootingGuesses, GalerkinResampleCarriesAQuinticToAnyGridWithTwoBubbles) { check_resample_carries_polynomials<5>(); }
 
 // Multipliers are densities: through the Gauss values, a polynomial of degree Q - 1 is exact.
 TEST(ShootingGuesses, GaussInterpolationIsExactOnPolynomialsOfDegreeQMinusOne) {
