@@ -1,7 +1,7 @@
 // A problem given by its continuous model (core/continuous.hpp: ℓ, constraints χ, connection)
 // and a descriptor: everything the application does with it on the Galerkin schemes of order 4
-// and 6, and 8 with MaxOrder = 8 (METHOD.md §9) — boundary conditions from the scene, a guess, the solve, the columns,
-// the momentum — with nothing written per problem. A problem with a discrete form too (the
+// and 6, and 8 with MaxOrder = 8 (METHOD.md §9) — boundary conditions from the scene, a guess,
+// the solve, the columns, the momentum — with nothing written per problem. A problem with a discrete form too (the
 // paper's windows) derives from it and overrides solve_paper and check_paper.
 //
 //   const ModelProblem<MyModel> my_problem(my_descriptor(), [](const ParameterValues& v) { ... });
