@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <mutex>
 
 namespace lpshoot::app {
 namespace {
@@ -82,6 +83,9 @@ LoadedPlugin load_problem_file(const std::string& source, const PluginOptions& o
                                "register it with LPSHOOT_REGISTER_PROBLEM(object) (README, \"A problem of your own\")");
   // The same library loaded again (dlopen returns the same handle, so the same objects): its
   // problems are registered already, and loading it is a no-op (a Python session re-running a cell).
+  // Checked and registered as one (threads of a Python session may load files at once).
+  static std::mutex registering;
+  const std::lock_guard<std::mutex> lock(registering);
   for (const Problem* p : c.problems) {
     const std::string& name = p->descriptor().name;
     if (const Problem* known = find_problem(name); known && known != p)

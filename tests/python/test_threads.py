@@ -54,3 +54,37 @@ def test_progress_lines_and_a_raising_callback():
 
     with pytest.raises(Stop):  # the callback's exception ends the run and reaches the caller
         lpshoot.solve(scene_path("beanie"), {"horizon.N": 100}, progress=stop)
+
+
+def test_loading_a_problem_file_releases_the_gil(tmp_path):
+    """A plugin build (here one that fails to compile: seconds of cmake and g++) leaves other
+    Python threads running: a counting thread keeps at least a fifth of its solo rate during the
+    call, where a held GIL would stop it for the whole call. The notification (quiet=False)
+    takes the GIL back to print."""
+    import threading
+    from pathlib import Path
+
+    bad = Path(__file__).resolve().parents[1] / "cli" / "plugins" / "syntax_error.cpp"
+    count, stop = [0], threading.Event()
+
+    def counter():
+        while not stop.is_set():
+            count[0] += 1
+
+    thread = threading.Thread(target=counter)
+    thread.start()
+    try:
+        time.sleep(0.3)
+        c0, t0 = count[0], time.perf_counter()
+        time.sleep(0.3)
+        solo_rate = (count[0] - c0) / (time.perf_counter() - t0)  # the counter alone (main thread asleep)
+        c0, t0 = count[0], time.perf_counter()
+        with pytest.raises(lpshoot.PluginError, match=r"syntax_error\.cpp:9:"):
+            lpshoot.load_problem(bad, cache_dir=tmp_path / "cache", quiet=False)
+        elapsed = time.perf_counter() - t0
+        rate = (count[0] - c0) / elapsed
+    finally:
+        stop.set()
+        thread.join()
+    assert elapsed > 0.5, f"the build took {elapsed:.2f} s: too short to tell"
+    assert rate > 0.2 * solo_rate, f"counter at {rate:.3g}/s during the load against {solo_rate:.3g}/s alone: GIL held"

@@ -122,11 +122,21 @@ py::dict check(const std::string& source, bool is_text, const std::vector<std::s
   return d;
 }
 
+// Builds (minutes the first time) and loads with the GIL released, so that other Python threads
+// run meanwhile; the notification takes it back.
 py::dict load_problem(const std::string& file, const std::string& cache_dir, const py::object& notify) {
   PluginOptions o;
   o.cache_dir = cache_dir;
-  if (!notify.is_none()) o.notify = [&notify](const std::string& what) { notify(what); };
-  const LoadedPlugin p = load_problem_file(file, o);
+  if (!notify.is_none())
+    o.notify = [&notify](const std::string& what) {
+      py::gil_scoped_acquire gil;
+      notify(what);
+    };
+  LoadedPlugin p;
+  {
+    py::gil_scoped_release release;
+    p = load_problem_file(file, o);
+  }
   py::dict d;
   d["source"] = p.source;
   d["library"] = p.library;
