@@ -6,7 +6,7 @@
 // gigabytes to compile under the sanitizers, so the checked build leaves them out; the Release
 // suite runs them. Order 8's convergence is tested on both paper examples through the CLI
 // (tests/cli, Sweep.GalerkinEightReachesOrderEightOnBothPaperExamples) and on the electron in
-// test_galerkin.cpp.
+// test_galerkin_electron.cpp.
 #include "galerkin_beanie_checks.hpp"
 #include "galerkin_group_checks.hpp"
 
