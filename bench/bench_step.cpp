@@ -72,6 +72,20 @@ static void BM_BeanieControlStep_EngineWithSensitivity(benchmark::State& st) {
 }
 BENCHMARK(BM_BeanieControlStep_EngineWithSensitivity);
 
+// The hand-written tangent-linear step (tests/oracles/analytic_steps.cpp): value and dz/d(state).
+static void BM_BeanieControlStep_AnalyticWithSensitivity(benchmark::State& st) {
+  const BeanieControl b = beanie();
+  const double h = 0.01;
+  const auto s = beanie_state(b, h);
+  oracles::BeanieStepSensitivity dz;
+  for (auto _ : st) {
+    auto z = oracles::beanie_control_analytic_step(b, s, h, dz);
+    benchmark::DoNotOptimize(z);
+    benchmark::DoNotOptimize(dz);
+  }
+}
+BENCHMARK(BM_BeanieControlStep_AnalyticWithSensitivity);
+
 static void BM_ElectronStep_Engine(benchmark::State& st) {
   const Electron e;
   const double h = 0.01;

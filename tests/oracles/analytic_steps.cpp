@@ -1,6 +1,7 @@
 #include "oracles/analytic_steps.hpp"
 
 #include <Eigen/Geometry>
+#include <Eigen/LU>
 
 #include <cmath>
 
@@ -107,6 +108,121 @@ StepUnknowns<BeanieControl> beanie_control_analytic_step(const BeanieControl& b,
   const double un = 2 * u(1) - u(0) - (h * h / mu) * ddV(psi(2)) * u(1) - (c / mu) * (l3_0 - 2 * l3_1 + l3_n);
   z.p(0) = h * h * (un - par.dV(psi(3))) / mu + 2 * psi(3) - psi(2);
   z.g = {s.g[2].angle, rot(b2) * t2};
+  return z;
+}
+
+// The tangent-linear form of the step above, line by line (no automatic differentiation). Each
+// quantity x carries dx, its row of derivatives in the state's 19 tangent coordinates
+// (FlowState's offsets): δψ_{n-2+i} moves ψ_i; g~ -> g~ exp(δ) moves an increment's angle by δ_ω
+// and its translation by R(angle) δ_t; δλ moves λ. Derivatives used:
+//   d/dβ R(-β) = -J R(-β), d²/dβ² R(-β) = -R(-β);  d/dβ (I - βJ) = -J;  d/dω R(ω) = J R(ω);
+//   Ad_{(β, t)}ᵀ M = (R(β)ᵀ M12, M3 - (J t)·M12)  (SE2::Ad);  V = A (1 - cos): V' = A sin, ...
+// The result ζ of g~_{n+1} = (ω_n, Rot(β_n) t_n) is (R(ω_n)ᵀ dt, dω) in the same right coordinates.
+StepUnknowns<BeanieControl> beanie_control_analytic_step(const BeanieControl& b, const FlowState<BeanieControl>& s,
+                                                         double h, BeanieStepSensitivity& dz) {
+  using Eigen::Matrix2d;
+  using Eigen::Vector2d;
+  using FS = FlowState<BeanieControl>;
+  constexpr int ns = Dims<BeanieControl>::state;
+  using Row = Eigen::Matrix<double, 1, ns>;
+  using Rows2 = Eigen::Matrix<double, 2, ns>;
+  const BeanieParameters& par = b.par;
+  const double c = par.c(), mu = par.mu(), A = par.amplitude;
+  const bool exact = b.variant == problems::BeanieConstraints::ExactRotation;
+  Matrix2d J;
+  J << 0, -1, 1, 0;
+  auto rot = [&](double beta) -> Matrix2d {
+    return exact ? SO2::rotation(-beta) : Matrix2d(Matrix2d::Identity() - beta * J);
+  };
+  auto drot = [&](double beta) -> Matrix2d { return exact ? Matrix2d(-J * SO2::rotation(-beta)) : Matrix2d(-J); };
+  auto ddrot = [&](double beta) -> Matrix2d { return exact ? Matrix2d(-SO2::rotation(-beta)) : Matrix2d::Zero(); };
+  auto unit = [](int col) {
+    Row e = Row::Zero();
+    e(col) = 1.0;
+    return e;
+  };
+
+  // Inputs and their derivative rows.
+  double psi[4];
+  Row dpsi[4];
+  for (int i = 0; i < 4; ++i) psi[i] = s.p[i](0), dpsi[i] = unit(FS::p_offset(i));
+  Row domega[3];
+  Rows2 dt[3];
+  for (int i = 0; i < 3; ++i) {
+    domega[i] = unit(FS::g_offset(i) + 2);
+    Rows2 delta = Rows2::Zero();
+    delta(0, FS::g_offset(i)) = 1.0, delta(1, FS::g_offset(i) + 1) = 1.0;
+    dt[i] = SO2::rotation(s.g[i].angle) * delta;
+  }
+  Rows2 dl12[2];
+  Row dl3[2];
+  for (int j = 0; j < 2; ++j) {
+    dl12[j] = Rows2::Zero();
+    dl12[j](0, FS::lam_offset(j)) = 1.0, dl12[j](1, FS::lam_offset(j) + 1) = 1.0;
+    dl3[j] = unit(FS::lam_offset(j) + 2);
+  }
+  const Vector2d l12_0 = s.lam[0].head<2>(), l12_1 = s.lam[1].head<2>();
+  const double l3_0 = s.lam[0](2), l3_1 = s.lam[1](2);
+
+  // u_i = μ Δ²ψ_i / h² + V'(ψ_{i+1}), i = 0, 1.
+  double u[2];
+  Row du[2];
+  for (int i = 0; i < 2; ++i) {
+    u[i] = mu * (psi[i + 2] - 2 * psi[i + 1] + psi[i]) / (h * h) + par.dV(psi[i + 1]);
+    du[i] = (mu / (h * h)) * (dpsi[i + 2] - 2 * dpsi[i + 1] + dpsi[i]) + A * std::cos(psi[i + 1]) * dpsi[i + 1];
+  }
+  // β_i = ω_i - c (ψ_{i+1} - ψ_i), i = 1, 2.
+  const double b1 = s.g[1].angle - c * (psi[2] - psi[1]), b2 = s.g[2].angle - c * (psi[3] - psi[2]);
+  const Row db1 = domega[1] - c * (dpsi[2] - dpsi[1]), db2 = domega[2] - c * (dpsi[3] - dpsi[2]);
+  const Vector2d t1 = s.g[1].t, t2 = s.g[2].t;
+
+  // M_{n-1} = (P1, Q1 + P1 · J t1).
+  const Matrix2d R1 = rot(b1), dR1 = drot(b1);
+  const Vector2d P1 = (l12_0 - R1.transpose() * l12_1) / h;
+  const Rows2 dP1 = (dl12[0] - (dR1.transpose() * l12_1) * db1 - R1.transpose() * dl12[1]) / h;
+  const Vector2d dR1t1 = dR1 * t1;
+  const double Q1 = (l3_0 - l3_1) / h - l12_1.dot(dR1t1) / h;
+  const Row dQ1 = (dl3[0] - dl3[1]) / h -
+                  (dR1t1.transpose() * dl12[1] + l12_1.dot(ddrot(b1) * t1) * db1 + l12_1.transpose() * dR1 * dt[1]) / h;
+  const double M1_3 = Q1 + P1.dot(J * t1);
+  const Row dM1_3 = dQ1 + (J * t1).transpose() * dP1 + P1.transpose() * J * dt[1];
+
+  // M_n = Ad_{(β1, t1)}ᵀ M_{n-1}.
+  const Matrix2d Rb1 = SO2::rotation(b1);
+  const Vector2d Pn = Rb1.transpose() * P1;
+  const Rows2 dPn = -(Rb1.transpose() * J * P1) * db1 + Rb1.transpose() * dP1;
+  const double Mn_3 = M1_3 - (J * t1).dot(P1);
+  const Row dMn_3 = dM1_3 - P1.transpose() * J * dt[1] - (J * t1).transpose() * dP1;
+  const double Qn = Mn_3 - Pn.dot(J * t2);
+  const Row dQn = dMn_3 - (J * t2).transpose() * dPn - Pn.transpose() * J * dt[2];
+
+  // λ12^n = Rot(β2)^{-T} (λ12^{n-1} - h Pn).
+  const Matrix2d R2 = rot(b2), dR2 = drot(b2);
+  const Eigen::PartialPivLU<Matrix2d> R2T(R2.transpose());
+  const Vector2d l12_n = R2T.solve(l12_1 - h * Pn);
+  const Rows2 dl12_n = R2T.solve(dl12[1] - h * dPn - (dR2.transpose() * l12_n) * db2);
+  // λ3^n = λ3^{n-1} + h (Gn - Qn), Gn = -λ12^n · Rot'(β2) t2 / h.
+  const Vector2d dR2t2 = dR2 * t2;
+  const double Gn = -l12_n.dot(dR2t2) / h;
+  const Row dGn = -(dR2t2.transpose() * dl12_n + l12_n.dot(ddrot(b2) * t2) * db2 + l12_n.transpose() * dR2 * dt[2]) / h;
+  const double l3_n = l3_1 + h * (Gn - Qn);
+  const Row dl3_n = dl3[1] + h * (dGn - dQn);
+
+  // u_n, then ψ_{n+2} = h² (u_n - V'(ψ_{n+1})) / μ + 2 ψ_{n+1} - ψ_n.
+  const double ddV2 = A * std::cos(psi[2]);
+  const double un = 2 * u[1] - u[0] - (h * h / mu) * ddV2 * u[1] - (c / mu) * (l3_0 - 2 * l3_1 + l3_n);
+  const Row dun = 2 * du[1] - du[0] - (h * h / mu) * (ddV2 * du[1] - A * std::sin(psi[2]) * u[1] * dpsi[2]) -
+                  (c / mu) * (dl3[0] - 2 * dl3[1] + dl3_n);
+
+  StepUnknowns<BeanieControl> z;
+  z.p(0) = h * h * (un - par.dV(psi[3])) / mu + 2 * psi[3] - psi[2];
+  z.g = {s.g[2].angle, R2 * t2};
+  z.lam << l12_n, l3_n;
+  dz.row(0) = (h * h / mu) * (dun - A * std::cos(psi[3]) * dpsi[3]) + 2 * dpsi[3] - dpsi[2];
+  dz.middleRows<2>(1) = SO2::rotation(z.g.angle).transpose() * (dR2t2 * db2 + R2 * dt[2]);
+  dz.row(3) = domega[2];
+  dz.middleRows<2>(4) = dl12_n;
+  dz.row(6) = dl3_n;
   return z;
 }
 

@@ -29,6 +29,14 @@ Eigen::Vector3d electron_analytic_step(const Electron& e, const std::array<Eigen
 StepUnknowns<BeanieControl> beanie_control_analytic_step(const BeanieControl& b,
                                                          const FlowState<BeanieControl>& s, double h);
 
+// The same step with its sensitivity dz/d(state) written by hand: the tangent-linear form of each
+// line of the closed form, in the engine's coordinates (step.hpp): rows (δψ_{n+2}, ζ with
+// g~_{n+1} -> g~_{n+1} exp(ζ), δλ^n), columns the state's (δψ per node, δ with g~ -> g~ exp(δ) per
+// increment, δλ). The oracle for step_sensitivity and the hand-written baseline of bench_step.
+using BeanieStepSensitivity = Eigen::Matrix<double, Dims<BeanieControl>::unknowns, Dims<BeanieControl>::state>;
+StepUnknowns<BeanieControl> beanie_control_analytic_step(const BeanieControl& b, const FlowState<BeanieControl>& s,
+                                                         double h, BeanieStepSensitivity& sensitivity);
+
 // The unreduced discrete Euler–Lagrange step of the free beanie, q = (x, y, θ, ψ), from the
 // same L_d (METHOD.md §6.2) written in q: Δr and Δθ + cΔψ are conserved and
 // μ (Δψ_n - Δψ_{n-1}) = -h^2 V'(ψ_n).
