@@ -93,3 +93,45 @@ TEST(Sensitivity, SeedColumnsAreDirectionalDerivatives) {
   const auto part = flow.run(init, 30, &seed);
   EXPECT_LT((full.sensitivity * seed - part.sensitivity).norm(), 1e-12 * part.sensitivity.norm());
 }
+
+namespace {
+// The step's derivatives in (z, state), window by window (step_sensitivity's path) against one
+// pass of nested duals in all nz + state directions (evaluate_step with the state seeded).
+template <class P>
+void check_step_derivatives_by_window(const P& problem, double h, const FlowState<P>& init) {
+  using D = Dims<P>;
+  constexpr int nz = D::unknowns, ns = D::state;
+  const auto res = DiscreteFlow<P>(problem, h).run(init, 3 * D::k);
+  ASSERT_TRUE(res.report.ok()) << res.report.message;
+  const int n = 2 * D::k;
+  const FlowState<P> s = res.trajectory.state(n);
+  StepUnknowns<P> z;
+  z.p = res.trajectory.p[n + D::k];
+  z.g = res.trajectory.g[n + D::k - 1];
+  if constexpr (D::m > 0) z.lam = res.trajectory.lam[n];
+  Vec<double, nz> F1, F2;
+  Eigen::Matrix<double, nz, nz + ns> J1, J2;
+  evaluate_step<P, nz + ns>(problem, h, s, z, true, nullptr, F1, J1);
+  evaluate_step_by_window(problem, h, s, z, F2, J2);
+  EXPECT_LT((F1 - F2).template lpNorm<Eigen::Infinity>(), 1e-13 * std::max(1.0, F1.template lpNorm<Eigen::Infinity>()));
+  EXPECT_LT((J1 - J2).template lpNorm<Eigen::Infinity>(), 1e-13 * J1.template lpNorm<Eigen::Infinity>());
+}
+}  // namespace
+
+TEST(Sensitivity, StepDerivativesWindowByWindowMatchOnePass) {
+  BeanieControl b;
+  b.par = {1.0, 1.0, 0.5, 1.0};
+  const double h = 0.05;
+  check_step_derivatives_by_window(
+      b, h,
+      test_support::beanie_control_initial(b, Eigen::Vector3d(0.5, 0.8, -0.5), Eigen::Vector3d(0.8, -0.3, 0.6),
+                                           Eigen::Vector3d(0.3, -0.2, 0.1), Eigen::Vector3d(0.302, -0.199, 0.101), h));
+  const problems::BeanieFree free{b.par};
+  check_step_derivatives_by_window(free, h,
+                                   test_support::beanie_free_initial(b.par, Eigen::Vector4d(0, 0, 0.1, 0.8),
+                                                                     Eigen::Vector4d(1, 0.5, 0.3, -0.2), h));
+  const Electron e{1.1, 0.8, Eigen::Vector3d(0.2, 0, 1.0), 1.0};
+  FlowState<Electron> s;
+  for (int i = 0; i < 4; ++i) s.p[i] = Eigen::Vector3d(1 + 0.01 * i, 0.05 * i, -0.02 * i * i);
+  check_step_derivatives_by_window(e, h, s);
+}
