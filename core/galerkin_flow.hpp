@@ -358,24 +358,88 @@ Vec<double, Sch::r> node_velocity_momentum(const typename Sch::Model& model, con
   return node_residual<Sch, double>(model, &tr.intervals[n - 1], nullptr, tr.h).template segment<r>(r);
 }
 
-// The jet at node n with p'' from the inverse Legendre transform ∂ℓ/∂p''(x_n, v_n, p'', Ω_n) = π_v
-// (Newton; ℓ must be strictly convex in p'', the regularity of a higher-order Lagrangian).
-// Ω' is not available at nodes and is set to zero (ℓ must not depend on it). False if Newton
-// does not converge.
+// Where node_jet's p'' comes from.
+enum class NodeJetSource {
+  LegendreTransform,  // ∂ℓ/∂p'' = π_v solved for p''
+  NodeDifferences,    // p'' = v' from the node velocities (node_derivative)
+};
+
+// The time derivative at node n of a node quantity f(j) (v or Ω), by differentiating the
+// polynomial through K = min(order + 1, N + 1) consecutive nodes around n (one-sided near the
+// ends). The scheme's node values carry an error smooth in t of order h^order (METHOD.md §9), so
+// the derivative keeps that order.
+template <class Sch, class F>
+auto node_derivative(const GalerkinTrajectory<Sch>& tr, int n, const F& f) {
+  const int N = tr.N(), K = std::min(Sch::order + 1, N + 1);
+  const int first = std::clamp(n - K / 2, 0, N + 1 - K);
+  auto out = f(n);
+  out.setZero();
+  // Lagrange basis j at nodes first..first+K-1 (unit spacing), differentiated at n:
+  // L_j'(n) = Σ_{m≠j} 1/(j - m) Π_{l≠j,m} (n - l)/(j - l).
+  for (int j = first; j < first + K; ++j) {
+    double w = 0;
+    for (int m = first; m < first + K; ++m) {
+      if (m == j) continue;
+      double term = 1.0 / (j - m);
+      for (int l = first; l < first + K; ++l)
+        if (l != j && l != m) term *= static_cast<double>(n - l) / (j - l);
+      w += term;
+    }
+    out += (w / tr.h) * f(j);
+  }
+  return out;
+}
+
+// Whether π_v = ∂L~/∂v_n determines p'' at a node through ℓ alone: the discrete Legendre
+// transform approximates ∂(ℓ + λ · χ)/∂p'', and Ω' is not known at the node before p''. So it
+// needs ∂χ/∂p'' = 0 and ∂²ℓ/∂p''∂Ω' = 0 (checked at q; automatic derivatives give exact zeros
+// for terms that are absent).
+template <class C>
+bool legendre_transform_applies(const C& model, const Jet<C, double>& q) {
+  constexpr int r = C::shape_dim, d = C::Group::dim, m = C::num_constraints;
+  using T1 = Dual<double, r + d>;
+  using T2 = Dual<T1, r>;
+  Jet<C, T2> qt;
+  qt.p = q.p.template cast<T2>(), qt.dp = q.dp.template cast<T2>(), qt.Omega = q.Omega.template cast<T2>();
+  for (int a = 0; a < r; ++a) {
+    qt.ddp(a) = T2(T1::variable(q.ddp(a), a));
+    qt.ddp(a).d[a] = T1(1.0);
+  }
+  for (int a = 0; a < d; ++a) qt.dOmega(a) = T2(T1::variable(q.dOmega(a), r + a));
+  const T2 l = model.template lagrangian<T2>(qt);
+  for (int a = 0; a < r; ++a)
+    for (int b = 0; b < d; ++b)
+      if (l.d[a].d[r + b] != 0.0) return false;
+  if constexpr (m > 0) {
+    const Vec<T2, m> chi = model_constraints(model, qt);
+    for (int c = 0; c < m; ++c)
+      for (int a = 0; a < r; ++a)
+        if (chi(c).d[a].v != 0.0) return false;
+  }
+  return true;
+}
+
+// The jet at node n. p, p' and Ω are the node's; Ω' is node_derivative of Ω. p'' solves the
+// inverse Legendre transform ∂ℓ/∂p''(x_n, v_n, p'', Ω_n, Ω'_n) = π_v (Newton; ℓ strictly convex in
+// p'', the regularity of a higher-order Lagrangian) where `source` asks for it and
+// legendre_transform_applies; otherwise it is node_derivative of v. Both are of the scheme's
+// order. `source`: in, the preferred source; out, the one used. False if Newton does not
+// converge or the jet is not finite.
 template <class Sch>
-bool node_jet(const typename Sch::Model& model, const GalerkinTrajectory<Sch>& tr, int n, Jet<typename Sch::Model, double>& q) {
+bool node_jet(const typename Sch::Model& model, const GalerkinTrajectory<Sch>& tr, int n, Jet<typename Sch::Model, double>& q,
+              NodeJetSource& source) {
   using C = typename Sch::Model;
   constexpr int r = Sch::r;
-  const Vec<double, r> pi = node_velocity_momentum(model, tr, n);
   q.p = tr.x(n);
   q.dp = tr.v(n);
   q.Omega = tr.Omega(n);
-  q.dOmega.setZero();
-  // Start from the curve's own p'' at the node (interval n's, or interval n-1's at the end).
-  if (n < tr.N())
-    q.ddp = 6.0 * tr.intervals[n].X2 - 2.0 * tr.intervals[n].V1;
-  else
-    q.ddp = -6.0 * tr.intervals[n - 1].X2 + 4.0 * tr.intervals[n - 1].V1;
+  q.ddp = node_derivative(tr, n, [&](int j) { return tr.v(j); });
+  if constexpr (Sch::d > 0) q.dOmega = node_derivative(tr, n, [&](int j) { return tr.Omega(j); });
+  if (source == NodeJetSource::NodeDifferences || !legendre_transform_applies(model, q)) {
+    source = NodeJetSource::NodeDifferences;
+    return q.ddp.allFinite() && q.dOmega.allFinite();
+  }
+  const Vec<double, r> pi = node_velocity_momentum(model, tr, n);
   using T1 = Dual<double, r>;
   using T2 = Dual<T1, r>;
   for (int it = 0; it < 20; ++it) {
@@ -397,6 +461,30 @@ bool node_jet(const typename Sch::Model& model, const GalerkinTrajectory<Sch>& t
     if (step.template lpNorm<Eigen::Infinity>() <= 1e-14 * (1.0 + q.ddp.template lpNorm<Eigen::Infinity>())) return true;
   }
   return false;
+}
+
+template <class Sch>
+bool node_jet(const typename Sch::Model& model, const GalerkinTrajectory<Sch>& tr, int n, Jet<typename Sch::Model, double>& q) {
+  NodeJetSource source = NodeJetSource::LegendreTransform;
+  return node_jet(model, tr, n, q, source);
+}
+
+// The jets at nodes 0..N from one source for all: the Legendre transform where it applies and
+// converges at every node, else node differences at every node. False if a jet is not finite.
+template <class Sch>
+bool node_jets(const typename Sch::Model& model, const GalerkinTrajectory<Sch>& tr, std::vector<Jet<typename Sch::Model, double>>& q,
+               NodeJetSource& source) {
+  q.assign(tr.N() + 1, {});
+  source = NodeJetSource::LegendreTransform;
+  for (int n = 0; n <= tr.N(); ++n) {
+    NodeJetSource used = source;
+    if (!node_jet(model, tr, n, q[n], used) || used != source) {
+      if (source == NodeJetSource::NodeDifferences) return false;
+      source = NodeJetSource::NodeDifferences;
+      n = -1;  // again from node 0, by node differences
+    }
+  }
+  return true;
 }
 
 }  // namespace lpshoot

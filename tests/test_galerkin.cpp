@@ -26,7 +26,7 @@ TEST(GalerkinBeanie, CubicIsOrderFourInEveryOutput) {
   const double T = 2.0;
   const Eigen::Vector2d Om12T = SO2::rotation(-1.0) * Eigen::Vector2d(0.5, 0.2);
   struct E {
-    double psi, u, cost, xy, Om;
+    double psi, u, cost, xy, Om, chi;  // chi: the constraints on the node jets (their Ω' from node differences)
   };
   std::vector<E> err;
   const std::vector<int> grids{10, 20, 40, 80};
@@ -38,12 +38,16 @@ TEST(GalerkinBeanie, CubicIsOrderFourInEveryOutput) {
     const auto bvp = beanie_galerkin_bvp<3>(model, T, N, s, e);
     const auto r = solve_bvp(bvp, beanie_galerkin_guess<3>(bvp, s, e));
     ASSERT_TRUE(r.ok()) << r.message;
-    E x{0, 0, std::abs(r.cost - ref.cost), 0, 0};
+    E x{0, 0, std::abs(r.cost - ref.cost), 0, 0, 0};
     for (int n = 0; n <= N; ++n) {
       x.psi = std::max(x.psi, std::abs(r.trajectory.x(n)(0) - ref.psi[n]));
       Jet<BeanieModel, double> q;
-      ASSERT_TRUE(node_jet(model, r.trajectory, n, q));
+      NodeJetSource source = NodeJetSource::LegendreTransform;
+      ASSERT_TRUE(node_jet(model, r.trajectory, n, q, source));
+      EXPECT_EQ(source, NodeJetSource::LegendreTransform);  // χ has no ψ'', ℓ no Ω'
       x.u = std::max(x.u, std::abs(model.control(q) - ref.u[n]));
+      // The continuous Ω' = (w Ω2, -w Ω1, 0) makes χ vanish; Ω' = 0 would leave |w Ω12| ≈ 0.2–0.4 at every N.
+      x.chi = std::max(x.chi, model.constraints(q).lpNorm<Eigen::Infinity>());
     }
     x.xy = std::max(std::abs(r.g.back().t(0) - 0.5 * T), std::abs(r.g.back().t(1) - 0.2 * T));
     const Eigen::Vector3d Om = r.trajectory.Omega(N);
@@ -56,10 +60,12 @@ TEST(GalerkinBeanie, CubicIsOrderFourInEveryOutput) {
     const E& b = err[i];
     const double o[5] = {std::log2(a.psi / b.psi), std::log2(a.u / b.u), std::log2(a.cost / b.cost), std::log2(a.xy / b.xy),
                          std::log2(a.Om / b.Om)};
-    std::printf("beanie N = %d: psi %.2e (%.2f) u %.2e (%.2f) cost %.2e (%.2f) x,y(T) %.2e (%.2f) Omega(T) %.2e (%.2f)\n",
-                grids[i], b.psi, o[0], b.u, o[1], b.cost, o[2], b.xy, o[3], b.Om, o[4]);
+    std::printf("beanie N = %d: psi %.2e (%.2f) u %.2e (%.2f) cost %.2e (%.2f) x,y(T) %.2e (%.2f) Omega(T) %.2e (%.2f) "
+                "chi at nodes %.2e (%.2f)\n",
+                grids[i], b.psi, o[0], b.u, o[1], b.cost, o[2], b.xy, o[3], b.Om, o[4], b.chi, std::log2(a.chi / b.chi));
     const char* what[5] = {"psi", "u", "cost", "x,y(T)", "Omega(T)"};
     for (int k = 0; k < 5; ++k) EXPECT_GE(o[k], 3.85) << what[k] << ", N = " << grids[i];
+    EXPECT_GE(std::log2(a.chi / b.chi), 3.6) << "Omega' at the nodes, N = " << grids[i];
   }
 }
 

@@ -259,6 +259,12 @@ RunRecord ModelProblem<Model, MaxOrder>::solve_galerkin(const Scene& s, const Pr
   std::vector<double> t;
   std::vector<std::vector<double>> x(r), v(r), c(d), w(d), out(D.outputs.size());
   std::vector<Vec<double, d>> P;
+  // The outputs' jets: p'' from the discrete Legendre transform where it applies, else from the
+  // node velocities; Ω' from the node values (node_jets).
+  std::vector<Jet<Model, double>> jets;
+  NodeJetSource source = NodeJetSource::LegendreTransform;
+  const bool have_jets = !D.outputs.empty() && outputs && node_jets(m, tr, jets, source);
+  if (have_jets) rec.outputs_from = source == NodeJetSource::LegendreTransform ? "legendre_transform" : "node_differences";
   for (int n = 0; n <= N; ++n) {
     t.push_back(tr.time(n));
     const Vec<double, r> xn = tr.x(n), vn = tr.v(n);
@@ -266,9 +272,7 @@ RunRecord ModelProblem<Model, MaxOrder>::solve_galerkin(const Scene& s, const Pr
     for (int i = 0; i < r; ++i) x[i].push_back(xn(i)), v[i].push_back(vn(i));
     for (int i = 0; i < d; ++i) c[i].push_back(cn(i)), w[i].push_back(wn(i));
     if (!D.outputs.empty()) {
-      Jet<Model, double> q;
-      const bool have = outputs && node_jet(m, tr, n, q);  // p'' from the discrete Legendre transform
-      const std::vector<double> o = have ? outputs(m, q) : std::vector<double>();
+      const std::vector<double> o = have_jets ? outputs(m, jets[n]) : std::vector<double>();
       for (size_t i = 0; i < D.outputs.size(); ++i) out[i].push_back(i < o.size() ? o[i] : nan());
     }
     if (physical_momentum) {

@@ -7,10 +7,10 @@
 // and the pendulum is not actuated, which is the constraint (its equation divided by m l)
 //   χ = l ψ'' + cos ψ Ω' + g sin ψ = 0.
 // The cart position does not enter ℓ or χ, so the scheme's momentum map J is conserved.
-// No force column: node outputs take p'' from the scheme's discrete Legendre transform, which
-// approximates ∂(ℓ + λ·χ)/∂p''; χ depends on ψ'' here, so u from it would carry the multiplier
-// (the spherical pendulum's χ does not). The force follows from the columns:
-// u = (M+m) v' + m l (cos ψ ψ_dot' − sin ψ ψ_dot²).
+// The force column u: χ depends on ψ'' and ℓ couples ψ'' with Ω', so the discrete Legendre
+// transform (which approximates ∂(ℓ + λ·χ)/∂ψ'') does not give ψ'' at the nodes; ψ'' and Ω'
+// come from differentiating the node values instead (core/galerkin_flow.hpp, node_jets; the
+// report says "outputs_from": "node_differences").
 #include <lpshoot/app/model_problem.hpp>
 
 #include <cmath>
@@ -56,8 +56,10 @@ ProblemDescriptor cart_pendulum_descriptor() {
                 {"psi_dot", NodePart::Velocity, 0, 1, false, "psi", "is given without psi (give psi too, or neither)"},
                 {"x", NodePart::Group, 0, 1, false, "", ""},
                 {"v", NodePart::Omega, 0, 1, false, "", ""}};
+  d.outputs = {"u"};
   d.plots = {{"cart position and pendulum angle", "t", {"x", "psi"}, false},
-             {"cart and pendulum velocities", "t", {"v", "psi_dot"}, false}};
+             {"cart and pendulum velocities", "t", {"v", "psi_dot"}, false},
+             {"cart force u", "t", {"u"}, false}};
   return d;
 }
 
@@ -65,6 +67,7 @@ ModelProblem<CartPendulum> make_problem() {
   ModelProblem<CartPendulum> p(cart_pendulum_descriptor(), [](const ParameterValues& v) {
     return CartPendulum{v.number("M"), v.number("m"), v.number("l"), v.number("g")};
   });
+  p.outputs = [](const CartPendulum& m, const Jet<CartPendulum, double>& q) { return std::vector<double>{m.control(q)}; };
   return p;
 }
 

@@ -87,6 +87,7 @@ json run_report(const Scene& scene, const RunRecord& r) {
     j["momentum_note"] = r.problem == "electron" ? "the symmetry group is trivial: no momentum map to conserve"
                                                  : "no trajectory";
   }
+  if (!r.outputs_from.empty()) j["outputs_from"] = r.outputs_from;
   j["wall_time_s"] = r.wall_time_s;
   json fin = json::object();
   for (const auto& [k, v] : r.final_state) fin[k] = finite_or_null(v);

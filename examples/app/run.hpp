@@ -60,6 +60,9 @@ struct RunRecord {
   double physical_momentum_drift = 0;
   std::vector<double> physical_momentum_initial;
   double wall_time_s = 0;
+  // Where the outputs' p'' comes from (core/galerkin_flow.hpp, node_jets): "legendre_transform"
+  // or "node_differences" (the node velocities differentiated); empty: no outputs.
+  std::string outputs_from;
   // solver.continuation: the parameter values solved, in order (the last is the scene's when
   // it was reached), and the number of solves including rejected steps.
   std::string continuation_parameter;

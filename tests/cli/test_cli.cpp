@@ -301,6 +301,7 @@ TEST(ModelProblems, SphericalPendulumFromOneFileSolvesAndConservesItsAngularMome
   ASSERT_EQ(o.code, 0) << o.out << o.err;
   const json report = json::parse(std::ifstream(out / "report.json"));
   EXPECT_EQ(report["scheme"], "galerkin6");
+  EXPECT_EQ(report["outputs_from"], "legendre_transform");  // χ has no φ'', ℓ no Ω'
   EXPECT_LT(report["momentum_drift_relative"].get<double>(), 1e-12);
   EXPECT_LT(report["physical_momentum_drift"].get<double>(), 1e-10);
   std::vector<std::string> header;
