@@ -32,7 +32,11 @@ TEST(AnalyticSteps, ElectronFlowMatchesHandSolvedStep) {
   EXPECT_LT(diff, 1e-8 * scale);
 }
 
-TEST(AnalyticSteps, BeanieControlStepMatchesHandSolvedStep) {
+namespace {
+// The beanie control cases: both constraint sets, V = 0 and V = 1 - cos ψ, each a flow of `steps`
+// steps (h = 0.02) from data with non-zero multipliers, handed to check(b, h, flow result).
+template <class F>
+void for_each_beanie_flow(int steps, const F& check) {
   for (auto variant : {BeanieConstraints::ExactRotation, BeanieConstraints::Paper}) {
     for (double amplitude : {0.0, 1.0}) {
       BeanieControl b;
@@ -42,24 +46,30 @@ TEST(AnalyticSteps, BeanieControlStepMatchesHandSolvedStep) {
       auto s = test_support::beanie_control_initial(b, Eigen::Vector3d(0.4, 0.8, -0.5), Eigen::Vector3d(0.5, 0.2, -0.7),
                                                Eigen::Vector3d(0.2, -0.1, 0.3), Eigen::Vector3d(0.201, -0.098, 0.302),
                                                h);
-      const DiscreteFlow<BeanieControl> flow(b, h);
-      const auto res = flow.run(s, 200);
+      const auto res = DiscreteFlow<BeanieControl>(b, h).run(s, steps);
       ASSERT_TRUE(res.report.ok()) << res.report.message;
-      double dp = 0, dg = 0, dl = 0;
-      for (int n = 2; n <= 200 - 2; ++n) {
-        const auto st = res.trajectory.state(n);
-        const auto z = oracles::beanie_control_analytic_step(b, st, h);
-        dp = std::max(dp, std::abs(z.p(0) - res.trajectory.p[n + 2](0)));
-        const auto& g = res.trajectory.g[n + 1];
-        dg = std::max(dg, std::max(std::abs(z.g.angle - g.angle), (z.g.t - g.t).lpNorm<Eigen::Infinity>()));
-        dl = std::max(dl, (z.lam - res.trajectory.lam[n]).lpNorm<Eigen::Infinity>() /
-                              std::max(1.0, z.lam.lpNorm<Eigen::Infinity>()));
-      }
-      EXPECT_LT(dp, 1e-12) << "psi";
-      EXPECT_LT(dg, 1e-14) << "increment";
-      EXPECT_LT(dl, 1e-9) << "multipliers";
+      check(b, h, res);
     }
   }
+}
+}  // namespace
+
+TEST(AnalyticSteps, BeanieControlStepMatchesHandSolvedStep) {
+  for_each_beanie_flow(200, [](const BeanieControl& b, double h, const FlowResult<BeanieControl>& res) {
+    double dp = 0, dg = 0, dl = 0;
+    for (int n = 2; n <= 200 - 2; ++n) {
+      const auto st = res.trajectory.state(n);
+      const auto z = oracles::beanie_control_analytic_step(b, st, h);
+      dp = std::max(dp, std::abs(z.p(0) - res.trajectory.p[n + 2](0)));
+      const auto& g = res.trajectory.g[n + 1];
+      dg = std::max(dg, std::max(std::abs(z.g.angle - g.angle), (z.g.t - g.t).lpNorm<Eigen::Infinity>()));
+      dl = std::max(dl, (z.lam - res.trajectory.lam[n]).lpNorm<Eigen::Infinity>() /
+                            std::max(1.0, z.lam.lpNorm<Eigen::Infinity>()));
+    }
+    EXPECT_LT(dp, 1e-12) << "psi";
+    EXPECT_LT(dg, 1e-14) << "increment";
+    EXPECT_LT(dl, 1e-9) << "multipliers";
+  });
 }
 
 // The engine's step sensitivity (implicit function theorem on derived Jacobians, step.hpp) against
@@ -68,47 +78,36 @@ TEST(AnalyticSteps, BeanieControlStepMatchesHandSolvedStep) {
 TEST(AnalyticSteps, BeanieControlSensitivityMatchesHandWrittenTangent) {
   using FS = FlowState<BeanieControl>;
   constexpr int ns = Dims<BeanieControl>::state;
-  for (auto variant : {BeanieConstraints::ExactRotation, BeanieConstraints::Paper}) {
-    for (double amplitude : {0.0, 1.0}) {
-      BeanieControl b;
-      b.par = {1.2, 0.8, 0.6, amplitude};
-      b.variant = variant;
-      const double h = 0.02;
-      auto s0 = test_support::beanie_control_initial(b, Eigen::Vector3d(0.4, 0.8, -0.5), Eigen::Vector3d(0.5, 0.2, -0.7),
-                                                Eigen::Vector3d(0.2, -0.1, 0.3), Eigen::Vector3d(0.201, -0.098, 0.302),
-                                                h);
-      const auto res = DiscreteFlow<BeanieControl>(b, h).run(s0, 60);
-      ASSERT_TRUE(res.report.ok()) << res.report.message;
-      double oracle_fd = 0, engine = 0;
-      for (int n : {2, 30, 58}) {
-        const FS s = res.trajectory.state(n);
-        oracles::BeanieStepSensitivity hand;
-        const auto z = oracles::beanie_control_analytic_step(b, s, h, hand);
-        const double scale = hand.lpNorm<Eigen::Infinity>();
-        // Central differences of the hand-solved step along each tangent coordinate (the state
-        // moved as the engine moves it, flow.hpp's retraction): error O(ε²) + roundoff / ε.
-        const double eps = 1e-6;
-        for (int col = 0; col < ns; ++col) {
-          Vec<double, ns> e = Vec<double, ns>::Zero();
-          e(col) = eps;
-          const auto zp = oracles::beanie_control_analytic_step(b, retract(s, e), h);
-          const auto zm = oracles::beanie_control_analytic_step(b, retract(s, Vec<double, ns>(-e)), h);
-          Vec<double, 7> d;
-          d(0) = zp.p(0) - zm.p(0);
-          d.segment<3>(1) = SE2::log(SE2::compose(SE2::inverse(zm.g), zp.g));
-          d.tail<3>() = zp.lam - zm.lam;
-          oracle_fd = std::max(oracle_fd, (d / (2 * eps) - hand.col(col)).lpNorm<Eigen::Infinity>() / scale);
-        }
-        const auto derived = step_sensitivity(b, h, s, z);
-        engine = std::max(engine, (derived - hand).lpNorm<Eigen::Infinity>() / scale);
+  for_each_beanie_flow(60, [](const BeanieControl& b, double h, const FlowResult<BeanieControl>& res) {
+    double oracle_fd = 0, engine = 0;
+    for (int n : {2, 30, 58}) {
+      const FS s = res.trajectory.state(n);
+      oracles::BeanieStepSensitivity hand;
+      const auto z = oracles::beanie_control_analytic_step(b, s, h, hand);
+      const double scale = hand.lpNorm<Eigen::Infinity>();
+      // Central differences of the hand-solved step along each tangent coordinate (the state
+      // moved as the engine moves it, flow.hpp's retraction): error O(ε²) + roundoff / ε.
+      const double eps = 1e-6;
+      for (int col = 0; col < ns; ++col) {
+        Vec<double, ns> e = Vec<double, ns>::Zero();
+        e(col) = eps;
+        const auto zp = oracles::beanie_control_analytic_step(b, retract(s, e), h);
+        const auto zm = oracles::beanie_control_analytic_step(b, retract(s, Vec<double, ns>(-e)), h);
+        Vec<double, 7> d;
+        d(0) = zp.p(0) - zm.p(0);
+        d.segment<3>(1) = SE2::log(SE2::compose(SE2::inverse(zm.g), zp.g));
+        d.tail<3>() = zp.lam - zm.lam;
+        oracle_fd = std::max(oracle_fd, (d / (2 * eps) - hand.col(col)).lpNorm<Eigen::Infinity>() / scale);
       }
-      std::printf("beanie step sensitivity (%s, amplitude %.0f): hand vs differences %.2e, engine vs hand %.2e\n",
-                  variant == BeanieConstraints::Paper ? "paper" : "exact", amplitude, oracle_fd, engine);
-      // Differences: ε² times third derivatives plus roundoff over ε (~1e-10 relative here).
-      EXPECT_LT(oracle_fd, 1e-8);
-      // Both are exact derivatives of the same equations at the same solution: roundoff only,
-      // amplified by the step matrix's condition (~1/h² for the ψ rows).
-      EXPECT_LT(engine, 1e-12);
+      const auto derived = step_sensitivity(b, h, s, z);
+      engine = std::max(engine, (derived - hand).lpNorm<Eigen::Infinity>() / scale);
     }
-  }
+    std::printf("beanie step sensitivity (%s, amplitude %.0f): hand vs differences %.2e, engine vs hand %.2e\n",
+                b.variant == BeanieConstraints::Paper ? "paper" : "exact", b.par.amplitude, oracle_fd, engine);
+    // Differences: ε² times third derivatives plus roundoff over ε (~1e-10 relative here).
+    EXPECT_LT(oracle_fd, 1e-8);
+    // Both are exact derivatives of the same equations at the same solution: roundoff only,
+    // amplified by the step matrix's condition (~1/h² for the ψ rows).
+    EXPECT_LT(engine, 1e-12);
+  });
 }

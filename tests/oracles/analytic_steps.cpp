@@ -17,6 +17,19 @@ Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& b) {
   K << 0, -b(2), b(1), b(2), 0, -b(0), -b(1), b(0), 0;
   return K;
 }
+
+// The beanie constraints' rotation Rot(β) = R(-β) (exact) or I - βJ (paper) and its first two
+// β-derivatives: -J R(-β), -R(-β); -J, 0.
+struct ConstraintRotation {
+  bool exact;
+  Eigen::Matrix2d J = (Eigen::Matrix2d() << 0, -1, 1, 0).finished();
+  explicit ConstraintRotation(const BeanieControl& b) : exact(b.variant == problems::BeanieConstraints::ExactRotation) {}
+  Eigen::Matrix2d rot(double beta) const {
+    return exact ? SO2::rotation(-beta) : Eigen::Matrix2d(Eigen::Matrix2d::Identity() - beta * J);
+  }
+  Eigen::Matrix2d drot(double beta) const { return exact ? Eigen::Matrix2d(-J * SO2::rotation(-beta)) : Eigen::Matrix2d(-J); }
+  Eigen::Matrix2d ddrot(double beta) const { return exact ? Eigen::Matrix2d(-SO2::rotation(-beta)) : Eigen::Matrix2d::Zero(); }
+};
 }  // namespace
 
 Eigen::Vector3d electron_stencil_residual(const Electron& e, const std::array<Eigen::Vector3d, 5>& xs, double h) {
@@ -74,13 +87,10 @@ StepUnknowns<BeanieControl> beanie_control_analytic_step(const BeanieControl& b,
   using Eigen::Vector2d;
   const BeanieParameters& par = b.par;
   const double c = par.c(), mu = par.mu();
-  const bool exact = b.variant == problems::BeanieConstraints::ExactRotation;
-  Matrix2d J;
-  J << 0, -1, 1, 0;
-  auto rot = [&](double beta) -> Matrix2d {
-    return exact ? SO2::rotation(-beta) : Matrix2d(Matrix2d::Identity() - beta * J);
-  };
-  auto drot = [&](double beta) -> Matrix2d { return exact ? Matrix2d(-J * SO2::rotation(-beta)) : Matrix2d(-J); };
+  const ConstraintRotation R(b);
+  const Matrix2d& J = R.J;
+  auto rot = [&](double beta) { return R.rot(beta); };
+  auto drot = [&](double beta) { return R.drot(beta); };
   auto psi = [&](int i) { return s.p[i](0); };  // ψ_{n-2+i}
   auto ddV = [&](double x) { return par.amplitude * std::cos(x); };
   auto u = [&](int i) { return mu * (psi(i + 2) - 2 * psi(i + 1) + psi(i)) / (h * h) + par.dV(psi(i + 1)); };
@@ -128,14 +138,11 @@ StepUnknowns<BeanieControl> beanie_control_analytic_step(const BeanieControl& b,
   using Rows2 = Eigen::Matrix<double, 2, ns>;
   const BeanieParameters& par = b.par;
   const double c = par.c(), mu = par.mu(), A = par.amplitude;
-  const bool exact = b.variant == problems::BeanieConstraints::ExactRotation;
-  Matrix2d J;
-  J << 0, -1, 1, 0;
-  auto rot = [&](double beta) -> Matrix2d {
-    return exact ? SO2::rotation(-beta) : Matrix2d(Matrix2d::Identity() - beta * J);
-  };
-  auto drot = [&](double beta) -> Matrix2d { return exact ? Matrix2d(-J * SO2::rotation(-beta)) : Matrix2d(-J); };
-  auto ddrot = [&](double beta) -> Matrix2d { return exact ? Matrix2d(-SO2::rotation(-beta)) : Matrix2d::Zero(); };
+  const ConstraintRotation R(b);
+  const Matrix2d& J = R.J;
+  auto rot = [&](double beta) { return R.rot(beta); };
+  auto drot = [&](double beta) { return R.drot(beta); };
+  auto ddrot = [&](double beta) { return R.ddrot(beta); };
   auto unit = [](int col) {
     Row e = Row::Zero();
     e(col) = 1.0;
