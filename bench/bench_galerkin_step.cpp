@@ -58,14 +58,17 @@ void flow(benchmark::State& st, const typename Sch::Model& model, const Interval
   constexpr int steps = 200;
   const GalerkinFlow<Sch> f(model, h);
   const Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(Sch::state, Sch::state);
+  int iterations = 0;
   for (auto _ : st) {
     auto r = f.run(start, steps, sensitivity ? &seed : nullptr, Sch::Group::template identity<double>(), 0, false);
     if (!r.report.ok()) st.SkipWithError(r.report.message.c_str());
+    iterations = r.report.total_iterations;
     benchmark::DoNotOptimize(r.sensitivity.data());
   }
   // Seconds per step (printed with an SI prefix: 120u = 120 µs).
   st.counters["per_step"] = benchmark::Counter(static_cast<double>(steps) * st.iterations(),
                                                benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  st.counters["newton_per_step"] = static_cast<double>(iterations) / steps;  // the step solves' iterations
 }
 
 BeanieModel beanie() {
