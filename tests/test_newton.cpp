@@ -170,6 +170,30 @@ CubicSystem stiff_system() {
   s.b(0) *= 1e6;
   return s;
 }
+
+double relative_error(const V3& z, const V3& exact) {
+  return ((z - exact).cwiseAbs().array() / (1.0 + exact.cwiseAbs().array())).maxCoeff();
+}
+
+// Two consecutive steps of the stiff system, the second's data moved by `change` from the first's:
+// the first solved by Newton (leaving its matrix in `chord`), the second by a fresh Newton
+// (`exact`) and by chord steps from the first's solution with a residual noise of 3e-11
+// (`chorded`, polished).
+struct NoisyNextStep {
+  ChordMatrix<3> chord;
+  CubicSystem next = stiff_system();
+  Solve previous, exact, chorded;
+  NewtonOptions opt;
+};
+NoisyNextStep noisy_next_step(const V3& change) {
+  NoisyNextStep t;
+  t.previous = solve(stiff_system(), V3::Zero(), &t.chord);
+  t.next.b += change;
+  t.exact = solve(t.next, t.previous.z, nullptr);
+  t.opt.polish_chord = true;
+  t.chorded = solve(t.next, t.previous.z, &t.chord, t.opt, 3e-11);
+  return t;
+}
 }  // namespace
 
 // Chord steps that contracted 4-fold (ρ ≤ 1/4, shown above the noise) and then stall at the
@@ -177,22 +201,15 @@ CubicSystem stiff_system() {
 // the most costly part of a Galerkin step at h = 2e-5). The iterate is within the noise of the
 // root.
 TEST(NewtonChord, ChordStepsThatContractedThenStallAtTheNoiseAreConverged) {
-  const CubicSystem first = stiff_system();
-  ChordMatrix<3> chord;
-  const Solve a = solve(first, V3::Zero(), &chord);
-  ASSERT_EQ(a.report.status, StepStatus::Converged) << a.report.message;
-  CubicSystem next = first;  // the next step, close: the predictor is ~1e-7 off
-  next.b += V3(1e-1, -2e-7, 1e-7);
-  const Solve exact = solve(next, a.z, nullptr);
-  ASSERT_EQ(exact.report.status, StepStatus::Converged);
-  NewtonOptions opt;
-  opt.polish_chord = true;
-  const Solve s = solve(next, a.z, &chord, opt, 3e-11);
+  const NoisyNextStep t = noisy_next_step(V3(1e-1, -2e-7, 1e-7));  // the predictor is ~1e-7 off
+  ASSERT_EQ(t.previous.report.status, StepStatus::Converged) << t.previous.report.message;
+  ASSERT_EQ(t.exact.report.status, StepStatus::Converged);
+  const Solve& s = t.chorded;
   ASSERT_EQ(s.report.status, StepStatus::Converged) << s.report.message;
-  EXPECT_GT(chord.condition, 1e5);
+  EXPECT_GT(t.chord.condition, 1e5);
   EXPECT_EQ(s.jacobians, 0);
   EXPECT_LE(s.report.iterations, 5);
-  EXPECT_LT(((s.z - exact.z).cwiseAbs().array() / (1.0 + exact.z.cwiseAbs().array())).maxCoeff(), 1e-9);
+  EXPECT_LT(relative_error(s.z, t.exact.z), 1e-9);
 }
 
 // A correction within the step tolerance is polished by chord corrections until one is within
@@ -220,31 +237,24 @@ TEST(NewtonChord, APolishStopsWhenItsCorrectionsStopShrinking) {
 // beanie Galerkin 4 flow at h = 2e-5 took 47 µs a step with sensitivities instead of 34), and
 // the iterate is within the noise of the root a fresh Newton finds.
 TEST(NewtonChord, ChordStepsFromAPredictorWithinTheNoiseAreConverged) {
-  const CubicSystem first = stiff_system();
-  ChordMatrix<3> chord;
-  const Solve a = solve(first, V3::Zero(), &chord);
-  ASSERT_EQ(a.report.status, StepStatus::Converged) << a.report.message;
-  CubicSystem next = first;  // the next step: the predictor is ~1e-10 off, the noise 3e-11
-  next.b += V3(1e-4, -1e-10, 1e-10);
-  const Solve exact = solve(next, a.z, nullptr);
-  ASSERT_EQ(exact.report.status, StepStatus::Converged);
-  NewtonOptions opt;
-  opt.polish_chord = true;
-  const Solve s = solve(next, a.z, &chord, opt, 3e-11);
+  const NoisyNextStep t = noisy_next_step(V3(1e-4, -1e-10, 1e-10));  // ~1e-10 off, the noise 3e-11
+  ASSERT_EQ(t.previous.report.status, StepStatus::Converged) << t.previous.report.message;
+  ASSERT_EQ(t.exact.report.status, StepStatus::Converged);
+  const Solve& s = t.chorded;
   ASSERT_EQ(s.report.status, StepStatus::Converged) << s.report.message;
-  EXPECT_GT(chord.condition, 1e5);  // noise bound min(1e-8, 64 u cond) = 1e-8 relative
+  EXPECT_GT(t.chord.condition, 1e5);  // noise bound min(1e-8, 64 u cond) = 1e-8 relative
   EXPECT_EQ(s.jacobians, 0);
   EXPECT_GE(s.report.iterations, 2);  // the first correction was not within the step tolerance
-  EXPECT_LT(((s.z - exact.z).cwiseAbs().array() / (1.0 + exact.z.cwiseAbs().array())).maxCoeff(), 1e-9);
+  EXPECT_LT(relative_error(s.z, t.exact.z), 1e-9);
   // A carried matrix whose chord steps diverge (a fifth of the step's: each correction -4 times
   // the last) is refreshed, even from within the noise, and lands on the same root.
   ChordMatrix<3> poor;
-  const M3 fifth = 0.2 * next.J(a.z);
+  const M3 fifth = 0.2 * t.next.J(t.previous.z);
   poor.lu.compute(fifth);
   poor.condition = condition_number_1(fifth, poor.lu);
   poor.valid = true;
-  const Solve t = solve(next, a.z, &poor, opt, 3e-11);
-  ASSERT_EQ(t.report.status, StepStatus::Converged) << t.report.message;
-  EXPECT_GE(t.jacobians, 1);
-  EXPECT_LT(((t.z - exact.z).cwiseAbs().array() / (1.0 + exact.z.cwiseAbs().array())).maxCoeff(), 1e-9);
+  const Solve u = solve(t.next, t.previous.z, &poor, t.opt, 3e-11);
+  ASSERT_EQ(u.report.status, StepStatus::Converged) << u.report.message;
+  EXPECT_GE(u.jacobians, 1);
+  EXPECT_LT(relative_error(u.z, t.exact.z), 1e-9);
 }
