@@ -6,13 +6,13 @@
 #pragma once
 
 #include "beanie_galerkin_start.hpp"
+#include "jacobian_check.hpp"
 
 #include <lpshoot/problems/beanie_bvp.hpp>
 
 #include <gtest/gtest.h>
 
 #include <cstdio>
-#include <random>
 #include <vector>
 
 namespace lpshoot::test_support {
@@ -106,27 +106,12 @@ void check_shooting_jacobian() {
     NewtonOptions tight;
     tight.step_tolerance = 1e-13;
     detail::ShootingSystem<Sch> sys(bvp, refs, starts, tight, 1);
-    std::mt19937 rng(5);
-    std::normal_distribution<double> n01;
-    Eigen::VectorXd x(sys.size());
-    for (int i = 0; i < x.size(); ++i) x(i) = 1e-3 * n01(rng);
+    const Eigen::VectorXd x = random_point(sys.size());
     SparseJacobian Js;
     ASSERT_TRUE(sys.jacobian(x, Js));
     const Eigen::MatrixXd J(Js);
     // Richardson-extrapolated central differences (truncation O(eps^4), noise ~1e-13/eps).
-    double worst = 0;
-    const double eps = 1e-5;
-    for (int j = 0; j < sys.size(); ++j) {
-      auto central = [&](double step) {
-        Eigen::VectorXd xp = x, xm = x, Fp, Fm;
-        xp(j) += step;
-        xm(j) -= step;
-        EXPECT_TRUE(sys.residual(xp, Fp) && sys.residual(xm, Fm));
-        return Eigen::VectorXd((Fp - Fm) / (2 * step));
-      };
-      const Eigen::VectorXd fd = (4 * central(eps) - central(2 * eps)) / 3;
-      worst = std::max(worst, (J.col(j) - fd).lpNorm<Eigen::Infinity>() / std::max(1.0, fd.lpNorm<Eigen::Infinity>()));
-    }
+    const double worst = richardson_jacobian_error(sys, x, J, 1e-5);
     std::printf("degree %d, segments %d: %d unknowns, max relative Jacobian error %.2e\n", S, segs, sys.size(), worst);
     EXPECT_LT(worst, 1e-6);
   }

@@ -1,6 +1,7 @@
 // The shooting machinery itself: the exact Jacobian (flow sensitivities, group element included,
 // difference basis) against finite differences, and an unstable problem on which single shooting
 // breaks down while multiple shooting converges (METHOD.md §5).
+#include "jacobian_check.hpp"
 #include "oracles/continuous.hpp"
 
 #include <lpshoot/problems/beanie_bvp.hpp>
@@ -8,10 +9,10 @@
 
 #include <gtest/gtest.h>
 
-#include <random>
 
 using namespace lpshoot;
 using namespace lpshoot::problems;
+using lpshoot::test_support::richardson_jacobian_error;
 
 TEST(ShootingSystem, JacobianMatchesFiniteDifferencesWithGroupsAndSegments) {
   BeanieControl b;
@@ -29,10 +30,7 @@ TEST(ShootingSystem, JacobianMatchesFiniteDifferencesWithGroupsAndSegments) {
     std::vector<BoundaryState<BeanieControl>> refs;
     for (int i = 0; i < S; ++i) refs.push_back({guess.trajectory.state(starts[i]), g[starts[i] - 2]});
     detail::ShootingSystem<BeanieControl> sys(bvp, refs, starts, NewtonOptions{}, 1);
-    std::mt19937 rng(5);
-    std::normal_distribution<double> n01;
-    Eigen::VectorXd x(sys.size());
-    for (int i = 0; i < x.size(); ++i) x(i) = 1e-3 * n01(rng);
+    const Eigen::VectorXd x = lpshoot::test_support::random_point(sys.size());
     SparseJacobian Js;
     ASSERT_TRUE(sys.jacobian(x, Js));
     const Eigen::MatrixXd J(Js);
@@ -40,22 +38,7 @@ TEST(ShootingSystem, JacobianMatchesFiniteDifferencesWithGroupsAndSegments) {
     // already agree with J to 1e-6 (the noise floor: the flow's Newton tolerance, ~1e-12/eps), or their error shrinks like eps^4 towards J. A wrong J would
     // leave an error that does not shrink. (The third-difference directions of the unknowns have
     // leverage ~1e4 on the terminal rows, so single shooting's differences are truncation-limited.)
-    auto worst_error = [&](double eps) {
-      double worst = 0;
-      for (int j = 0; j < sys.size(); ++j) {
-        auto central = [&](double step) {
-          Eigen::VectorXd xp = x, xm = x, Fp, Fm;
-          xp(j) += step;
-          xm(j) -= step;
-          EXPECT_TRUE(sys.residual(xp, Fp) && sys.residual(xm, Fm));
-          return Eigen::VectorXd((Fp - Fm) / (2 * step));
-        };
-        const Eigen::VectorXd fd = (4 * central(eps) - central(2 * eps)) / 3;
-        worst = std::max(worst, (J.col(j) - fd).lpNorm<Eigen::Infinity>() / std::max(1.0, fd.lpNorm<Eigen::Infinity>()));
-      }
-      return worst;
-    };
-    const double coarse = worst_error(4e-5), worst = worst_error(2e-5);
+    const double coarse = richardson_jacobian_error(sys, x, J, 4e-5), worst = richardson_jacobian_error(sys, x, J, 2e-5);
     std::printf("segments %d: %d unknowns, max relative Jacobian error %.2e (at twice the step %.2e)\n", S,
                 sys.size(), worst, coarse);
     EXPECT_TRUE(worst < 1e-6 || worst < coarse / 8) << "errors " << coarse << " -> " << worst;
