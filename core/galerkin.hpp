@@ -78,15 +78,26 @@ struct GroupCurveEnds {
   Vec<T, Sch::d> zeta, omega0, omega1;
 };
 
+// The ends from ζ = log W and the interval's base node and increments (the interval's x_end,
+// v_end and Om_end, written out so that ζ can come from elsewhere: galerkin_group_interval.hpp
+// differentiates ζ, which depends on W alone, in its own few directions).
+template <class Sch, class T>
+GroupCurveEnds<Sch, T> group_curve_ends_from(const typename Sch::Model& model, const Vec<T, Sch::d>& zeta,
+                                             const Vec<T, Sch::r>& x, const Vec<T, Sch::r>& v,
+                                             const Vec<T, Sch::r>& X2, const Vec<T, Sch::r>& V1,
+                                             const Vec<T, Sch::d>& Om, const Vec<T, Sch::d>& O1, double h) {
+  GroupCurveEnds<Sch, T> e;
+  e.zeta = zeta;
+  e.omega0 = Om - connection_velocity_of(model, x, v);
+  const Vec<T, Sch::r> x_end = x + h * v + (h * h) * X2, v_end = v + h * V1;
+  const Vec<T, Sch::d> end_velocity = (Om + h * O1) - connection_velocity_of(model, x_end, v_end);
+  e.omega1 = right_jacobian_inverse_times<typename Sch::Group, T>(zeta, end_velocity);
+  return e;
+}
+
 template <class Sch, class T>
 GroupCurveEnds<Sch, T> group_curve_ends(const typename Sch::Model& model, const Interval<Sch, T>& iv, double h) {
-  using G = typename Sch::Group;
-  GroupCurveEnds<Sch, T> e;
-  e.zeta = G::log(iv.W);
-  e.omega0 = iv.Om - connection_velocity_of(model, iv.x, iv.v);
-  const Vec<T, Sch::d> end_velocity = iv.Om_end(h) - connection_velocity_of(model, iv.x_end(h), iv.v_end(h));
-  e.omega1 = right_jacobian_inverse_times<G, T>(e.zeta, end_velocity);
-  return e;
+  return group_curve_ends_from<Sch, T>(model, Sch::Group::log(iv.W), iv.x, iv.v, iv.X2, iv.V1, iv.Om, iv.O1, h);
 }
 
 // What the jet at Gauss point i is made of: p, p', p'' and the time derivatives ξ, ξ', ξ'' of
@@ -148,6 +159,18 @@ JetInputs<Sch, T> jet_inputs_at(const Interval<Sch, T>& iv, const GroupCurveEnds
 
 // The jet q = (p, p', p'', Ω, Ω') from its inputs: Ω, Ω' the body velocity of exp(ξ) and its
 // derivative, plus 𝒜(p) p' and its time derivative.
+// Ω += 𝒜(p) p' and Ω' += its time derivative (nothing without a connection form).
+template <class Sch, class T>
+void add_connection_part(const typename Sch::Model& model, Jet<typename Sch::Model, T>& q) {
+  if constexpr (detail::HasConnectionForm<typename Sch::Model, T>::value) {
+    Vec<T, Sch::d> cv, dcv;
+    connection_jet(model, q.p, q.dp, q.ddp, cv, dcv);
+    q.Omega += cv;
+    q.dOmega += dcv;
+  }
+  (void)model, (void)q;
+}
+
 template <class Sch, class T>
 Jet<typename Sch::Model, T> jet_from_inputs(const typename Sch::Model& model, const JetInputs<Sch, T>& u) {
   using C = typename Sch::Model;
@@ -157,12 +180,7 @@ Jet<typename Sch::Model, T> jet_from_inputs(const typename Sch::Model& model, co
   q.ddp = u.ddp;
   if constexpr (Sch::d > 0) {
     body_velocity_jet<typename Sch::Group, T>(u.xi0, u.xi1, u.xi2, q.Omega, q.dOmega);
-    if constexpr (detail::HasConnectionForm<C, T>::value) {  // + 𝒜(p) p' and its time derivative
-      Vec<T, Sch::d> cv, dcv;
-      connection_jet(model, q.p, q.dp, q.ddp, cv, dcv);
-      q.Omega += cv;
-      q.dOmega += dcv;
-    }
+    add_connection_part<Sch, T>(model, q);
   }
   (void)model;
   return q;

@@ -135,22 +135,80 @@ const JetInputMaps<Sch>& jet_input_maps(double h) {
   return maps;
 }
 
-// The jet inputs as nu seeded variables of T, in JetInputMaps' order (p, p', p'', ξ, ξ', ξ'').
-template <class Sch, class T>
-JetInputs<Sch, T> seeded_jet_inputs(const Vec<double, 3 * Sch::r + 3 * Sch::d>& value) {
-  constexpr int r = Sch::r, d = Sch::d;
-  JetInputs<Sch, T> u;
-  for (int a = 0; a < r; ++a) {
-    u.p(a) = T::variable(value(a), a);
-    u.dp(a) = T::variable(value(r + a), r + a);
-    u.ddp(a) = T::variable(value(2 * r + a), 2 * r + a);
+// a, a function of M variables, as a function of N >= M whose variables first .. first + M - 1
+// are a's, written into e, which must be zero.
+template <int N, int M>
+void embed(Hess<N>& e, const Hess<M>& a, int first) {
+  e.v = a.v;
+  int k = 0;
+  for (int i = 0; i < M; ++i) {
+    e.g[first + i] = a.g[i];
+    double* row = &e.H[Hess<N>::at(first + i, first + i)];
+    for (int j = i; j < M; ++j, ++k) row[j - i] = a.H[k];
   }
+}
+
+// The group curve's ends e(y) in Hess<4r + 3d> over (x, v, Ω, X2, V1, O1, δ), as
+// group_curve_ends of seeded_state(iv, h, 0, false) gives them. ζ = log(W exp(h δ)) depends on
+// δ alone: its group operations run in Hess<d> and are embedded, instead of in all 4r + 3d
+// directions with the whole interval cast to T (beanie: 18% of a Galerkin 4 step with
+// sensitivities went to them).
+template <class Sch>
+GroupCurveEnds<Sch, Hess<4 * Sch::r + 3 * Sch::d>> seeded_group_curve_ends(const typename Sch::Model& model,
+                                                                          const Interval<Sch, double>& iv, double h) {
+  using G = typename Sch::Group;
+  constexpr int r = Sch::r, d = Sch::d, n = 4 * r + 3 * d;
+  using T = Hess<n>;
+  using TZ = Hess<d>;
+  typename G::template Tangent<TZ> delta;
+  for (int a = 0; a < d; ++a) delta(a) = TZ::variable(0.0, a) * h;  // W exp(h δ)
+  const typename G::template Tangent<TZ> zeta_d = G::log(G::compose(G::template cast<TZ>(iv.W), G::template exp<TZ>(delta)));
+  Vec<T, d> zeta, Om, O1;
+  Vec<T, r> x, v, X2, V1;
   for (int a = 0; a < d; ++a) {
-    u.xi0(a) = T::variable(value(3 * r + a), 3 * r + a);
-    u.xi1(a) = T::variable(value(3 * r + d + a), 3 * r + d + a);
-    u.xi2(a) = T::variable(value(3 * r + 2 * d + a), 3 * r + 2 * d + a);
+    embed(zeta(a), zeta_d(a), Sch::W_off);
+    Om(a) = T::variable(iv.Om(a), Sch::Om_off + a);
+    O1(a) = T::variable(iv.O1(a), Sch::O1_off + a);
   }
-  return u;
+  for (int a = 0; a < r; ++a) {
+    x(a) = T::variable(iv.x(a), Sch::x_off + a);
+    v(a) = T::variable(iv.v(a), Sch::v_off + a);
+    X2(a) = T::variable(iv.X2(a), Sch::X2_off + a);
+    V1(a) = T::variable(iv.V1(a), Sch::V1_off + a);
+  }
+  return group_curve_ends_from<Sch, T>(model, zeta, x, v, X2, V1, Om, O1, h);
+}
+
+// jet_from_inputs at the jet inputs u = (p, p', p'', ξ, ξ', ξ'') (JetInputMaps' order), seeded
+// in Hess<3r + 3d>. The
+// body velocity depends on the 3d inputs ξ, ξ', ξ'' alone: it runs in Hess<3d> and is embedded
+// (beanie: Hess<9> instead of Hess<12>, where a fifth of a Galerkin 4 step with sensitivities
+// went).
+template <class Sch>
+Jet<typename Sch::Model, Hess<3 * Sch::r + 3 * Sch::d>> seeded_jet(const typename Sch::Model& model,
+                                                                   const Vec<double, 3 * Sch::r + 3 * Sch::d>& u) {
+  constexpr int r = Sch::r, d = Sch::d, nu = 3 * r + 3 * d;
+  using T = Hess<nu>;
+  using TX = Hess<3 * d>;
+  Jet<typename Sch::Model, T> q;
+  for (int a = 0; a < r; ++a) {  // q's scalars start at zero
+    q.p(a).v = u(a), q.p(a).g[a] = 1.0;
+    q.dp(a).v = u(r + a), q.dp(a).g[r + a] = 1.0;
+    q.ddp(a).v = u(2 * r + a), q.ddp(a).g[2 * r + a] = 1.0;
+  }
+  Vec<TX, d> xi0, xi1, xi2, Om, dOm;
+  for (int a = 0; a < d; ++a) {
+    xi0(a) = TX::variable(u(3 * r + a), a);
+    xi1(a) = TX::variable(u(3 * r + d + a), d + a);
+    xi2(a) = TX::variable(u(3 * r + 2 * d + a), 2 * d + a);
+  }
+  body_velocity_jet<typename Sch::Group, TX>(xi0, xi1, xi2, Om, dOm);
+  for (int a = 0; a < d; ++a) {
+    embed(q.Omega(a), Om(a), 3 * r);
+    embed(q.dOmega(a), dOm(a), 3 * r);
+  }
+  add_connection_part<Sch, T>(model, q);
+  return q;
 }
 
 // The file comment's chain rule.
@@ -166,7 +224,7 @@ IntervalDerivatives<Sch> group_interval_derivatives_chained(const typename Sch::
 
   // The ends e(y) with their gradients and Hessians. They do not depend on the bubbles, the
   // last coordinates of y: Hess in the first ny_e only.
-  const GroupCurveEnds<Sch, TE> ends = group_curve_ends(model, seeded_state<Sch, TE>(iv, h, 0, false), h);
+  const GroupCurveEnds<Sch, TE> ends = seeded_group_curve_ends<Sch>(model, iv, h);
   const TE* e[ne];
   for (int a = 0; a < d; ++a) e[a] = &ends.zeta(a), e[d + a] = &ends.omega0(a), e[2 * d + a] = &ends.omega1(a);
   Eigen::Matrix<double, ne, ny> De = Eigen::Matrix<double, ne, ny>::Zero();
@@ -190,7 +248,7 @@ IntervalDerivatives<Sch> group_interval_derivatives_chained(const typename Sch::
     const Eigen::Matrix<double, nu, ne>& A = maps.A[i];
     const Vec<double, nu> u = A * ev + maps.B[i] * y;
     const Eigen::Matrix<double, nu, ny> Ju = maps.B[i] + A.lazyProduct(De);
-    const Jet<typename Sch::Model, TU> q = jet_from_inputs<Sch, TU>(model, seeded_jet_inputs<Sch, TU>(u));
+    const Jet<typename Sch::Model, TU> q = seeded_jet<Sch>(model, u);
     TU phi = model.template lagrangian<TU>(q);
     if constexpr (m > 0) {
       const Vec<TU, m> chi = model.template constraints<TU>(q);
