@@ -157,8 +157,6 @@ JetInputs<Sch, T> jet_inputs_at(const Interval<Sch, T>& iv, const GroupCurveEnds
   return u;
 }
 
-// The jet q = (p, p', p'', Ω, Ω') from its inputs: Ω, Ω' the body velocity of exp(ξ) and its
-// derivative, plus 𝒜(p) p' and its time derivative.
 // Ω += 𝒜(p) p' and Ω' += its time derivative (nothing without a connection form), for
 // galerkin_group_interval.hpp's seeded_jet. jet_from_inputs writes the same inline: called
 // there, GCC left this call out of line in the residuals (Dual<12>), 4% slower on Galerkin 6.
@@ -173,6 +171,8 @@ void add_connection_part(const typename Sch::Model& model, Jet<typename Sch::Mod
   (void)model, (void)q;
 }
 
+// The jet q = (p, p', p'', Ω, Ω') from its inputs: Ω, Ω' the body velocity of exp(ξ) and its
+// derivative, plus 𝒜(p) p' and its time derivative.
 template <class Sch, class T>
 Jet<typename Sch::Model, T> jet_from_inputs(const typename Sch::Model& model, const JetInputs<Sch, T>& u) {
   using C = typename Sch::Model;

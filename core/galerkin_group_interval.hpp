@@ -25,10 +25,9 @@
 namespace lpshoot {
 
 // The state interval with its smooth tangent coordinates (all but the multipliers, the last
-// Q m) seeded in columns first .. first + state - Q m - 1 of T; without `bubbles`, the bubbles
-// are left constant and T needs only the first 4r + 3d columns (x, v, Ω, X2, V1, O1, δ).
+// Q m) seeded in columns first .. first + state - Q m - 1 of T.
 template <class Sch, class T>
-Interval<Sch, T> seeded_state(const Interval<Sch, double>& state, double h, int first, bool bubbles = true) {
+Interval<Sch, T> seeded_state(const Interval<Sch, double>& state, double h, int first) {
   using G = typename Sch::Group;
   constexpr int r = Sch::r, d = Sch::d, nb = Sch::aux - multiplier_count<Sch>;
   Interval<Sch, T> s = state.template cast<T>();
@@ -47,8 +46,7 @@ Interval<Sch, T> seeded_state(const Interval<Sch, double>& state, double h, int 
     for (int a = 0; a < d; ++a) delta(a) = T::variable(0.0, first + Sch::W_off + a) * h;  // W exp(h δ)
     s.W = G::compose(s.W, G::template exp<T>(delta));
   }
-  if (bubbles)
-    for (int a = 0; a < nb; ++a) s.w(a) = T::variable(state.w(a), first + Sch::aux_off + a);
+  for (int a = 0; a < nb; ++a) s.w(a) = T::variable(state.w(a), first + Sch::aux_off + a);
   return s;
 }
 
@@ -148,8 +146,8 @@ void embed(Hess<N>& e, const Hess<M>& a, int first) {
   }
 }
 
-// The group curve's ends e(y) in Hess<4r + 3d> over (x, v, Ω, X2, V1, O1, δ), as
-// group_curve_ends of seeded_state(iv, h, 0, false) gives them. ζ = log(W exp(h δ)) depends on
+// The group curve's ends e(y) in Hess<4r + 3d> over (x, v, Ω, X2, V1, O1, δ), the first
+// 4r + 3d directions of group_curve_ends of seeded_state(iv, h, 0). ζ = log(W exp(h δ)) depends on
 // δ alone: its group operations run in Hess<d> and are embedded, instead of in all 4r + 3d
 // directions with the whole interval cast to T (beanie: 18% of a Galerkin 4 step with
 // sensitivities went to them).
@@ -180,10 +178,9 @@ GroupCurveEnds<Sch, Hess<4 * Sch::r + 3 * Sch::d>> seeded_group_curve_ends(const
 }
 
 // jet_from_inputs at the jet inputs u = (p, p', p'', ξ, ξ', ξ'') (JetInputMaps' order), seeded
-// in Hess<3r + 3d>. The
-// body velocity depends on the 3d inputs ξ, ξ', ξ'' alone: it runs in Hess<3d> and is embedded
-// (beanie: Hess<9> instead of Hess<12>, where a fifth of a Galerkin 4 step with sensitivities
-// went).
+// in Hess<3r + 3d>. The body velocity depends on the 3d inputs ξ, ξ', ξ'' alone: it runs in
+// Hess<3d> and is embedded (beanie: Hess<9> instead of Hess<12>, where a fifth of a Galerkin 4
+// step with sensitivities went).
 template <class Sch>
 Jet<typename Sch::Model, Hess<3 * Sch::r + 3 * Sch::d>> seeded_jet(const typename Sch::Model& model,
                                                                    const Vec<double, 3 * Sch::r + 3 * Sch::d>& u) {
