@@ -9,7 +9,6 @@
 
 #include <gtest/gtest.h>
 
-
 using namespace lpshoot;
 using namespace lpshoot::problems;
 using lpshoot::test_support::richardson_jacobian_error;
