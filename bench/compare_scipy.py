@@ -16,7 +16,7 @@ with analytic fun_jac and bc_jac, vectorized; lpshoot gets the scene only (it de
 equations from the Lagrangian). Timed: the solve_bvp call (repetitions in one Python process);
 lpshoot's solve (wall_time_s of the report, not the process start), warm: all grids in one
 `lpshoot sweep` process after a smaller warm-up grid (a new process's first solve also pays page faults
-and lazy symbol binding, ~1.3 ms; that time is printed too). Error: max over lpshoot's nodes
+and lazy symbol binding, ~0.2 ms on the electron and ~0.7 ms on the beanie; that time is printed too). Error: max over lpshoot's nodes
 (scipy: over 401 points) of the
 positions (electron) or of psi, theta, x, y (beanie).
 
