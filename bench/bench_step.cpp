@@ -86,6 +86,45 @@ static void BM_BeanieControlStep_AnalyticWithSensitivity(benchmark::State& st) {
 }
 BENCHMARK(BM_BeanieControlStep_AnalyticWithSensitivity);
 
+// The same step for the paper's windows derived from the continuous model (core/paper_windows.hpp,
+// central jet; its L_d is the hand-written L^_d (79), its constraints trapezoidal on log g~).
+using DerivedBeanie = PaperWindows<problems::BeanieModel>;
+
+static FlowState<DerivedBeanie> derived_beanie_state(double h) {
+  const auto s = beanie_state(beanie(), h);
+  FlowState<DerivedBeanie> d;
+  d.p = s.p, d.g = s.g, d.lam = s.lam;
+  return d;
+}
+
+static void BM_BeanieDerivedWindowsStep_Engine(benchmark::State& st) {
+  const DerivedBeanie b{problems::BeanieModel{beanie().par}};
+  const double h = 0.01;
+  const auto s = derived_beanie_state(h);
+  const NewtonOptions opt;
+  StepUnknowns<DerivedBeanie> z;
+  for (auto _ : st) {
+    const StepReport r = solve_step(b, h, s, 2, opt, z);
+    benchmark::DoNotOptimize(r.iterations);
+    benchmark::DoNotOptimize(z);
+  }
+}
+BENCHMARK(BM_BeanieDerivedWindowsStep_Engine);
+
+static void BM_BeanieDerivedWindowsStep_EngineWithSensitivity(benchmark::State& st) {
+  const DerivedBeanie b{problems::BeanieModel{beanie().par}};
+  const double h = 0.01;
+  const auto s = derived_beanie_state(h);
+  const NewtonOptions opt;
+  StepUnknowns<DerivedBeanie> z;
+  for (auto _ : st) {
+    solve_step(b, h, s, 2, opt, z);
+    auto dz = step_sensitivity(b, h, s, z);
+    benchmark::DoNotOptimize(dz);
+  }
+}
+BENCHMARK(BM_BeanieDerivedWindowsStep_EngineWithSensitivity);
+
 static void BM_ElectronStep_Engine(benchmark::State& st) {
   const Electron e;
   const double h = 0.01;

@@ -85,6 +85,29 @@ constexpr bool has_connection() {
   return detail::HasConnection<P, double>::value;
 }
 
+namespace detail {
+template <class P, class T, class = void>
+struct HasReducedVelocity : std::false_type {};
+template <class P, class T>
+struct HasReducedVelocity<P, T,
+                          std::void_t<decltype(std::declval<const P&>().template reduced_velocity<T>(
+                              std::declval<const Vec<T, P::shape_dim>&>(), std::declval<const Vec<T, P::shape_dim>&>(),
+                              std::declval<const GroupElement<P, T>&>(), 0.0))>> : std::true_type {};
+}  // namespace detail
+
+// The reduced group velocity that increment g~ between shapes p0 and p1 stands for: the
+// problem's own reduced_velocity (paper_windows.hpp), or log(g~)/h.
+template <class P, class T>
+Vec<T, P::Group::dim> reduced_velocity_of(const P& problem, const Vec<T, P::shape_dim>& p0, const Vec<T, P::shape_dim>& p1,
+                                          const GroupElement<P, T>& g, double h) {
+  if constexpr (detail::HasReducedVelocity<P, T>::value) {
+    return problem.template reduced_velocity<T>(p0, p1, g, h);
+  } else {
+    (void)p0, (void)p1;
+    return P::Group::log(g) / h;
+  }
+}
+
 // L~(a, λ) = L_d(a) + λ · chi_d(a)  (paper eq. 47).
 template <class P, class T>
 T augmented_lagrangian(const P& problem, const Window<P, T>& a, const Vec<T, P::num_constraints>& lam,

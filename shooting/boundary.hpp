@@ -10,6 +10,7 @@
 
 #include <lpshoot/core/lpshoot.hpp>
 
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,8 @@ enum class ConditionKind {
   FixedGroup,           // log(target^{-1} g_n)(i) = 0
   FixedIncrement,       // log(target^{-1} g~_j)(i) = 0, j = 0 or N-1; claims node 1 or N-1
   SecondOrderVelocity,  // (-3p_0 + 4p_1 - p_2)(i)/(2h) = value, or the mirror (3p_N - 4p_{N-1} + p_{N-2})
+  SecondOrderIncrement, // (3 ω_0 - ω_1)(i)/2 = value, or the mirror (3 ω_{N-1} - ω_{N-2}), ω_j the reduced
+                        // velocity of g~_j at t_{j+1/2} (reduced_velocity_of); claims node 1 or N-1
   Natural,              // ∂S/∂(component i of node n) = 0
 };
 
@@ -61,6 +64,13 @@ struct BoundaryValueProblem {
   void natural(End e, int offset, int component, std::string name) {
     conditions.push_back(
         {e, ConditionKind::Natural, offset, component, 0.0, P::Group::template identity<double>(), name});
+  }
+  // Component i of the reduced group velocity Ω at an end, from the first (last) two increments
+  // to second order (k = 2; the problems of core/paper_windows.hpp, whose Ω is log(g~)/h).
+  void increment_velocity(End e, int i, double value, std::string name) {
+    if (P::order < 2) throw std::invalid_argument("condition '" + name + "': a second-order increment velocity needs k >= 2");
+    conditions.push_back({e, ConditionKind::SecondOrderIncrement, 1, P::shape_dim + i, value,
+                          P::Group::template identity<double>(), name});
   }
   // Shape component i prescribed with its velocity at an end (k = 2: nodes 0, 1 or N, N-1).
   void shape_with_velocity(End e, int i, double position, double velocity, Closure c, const std::string& name) {
@@ -153,6 +163,13 @@ std::vector<T> boundary_residuals(const BoundaryValueProblem<P>& bvp, End e, con
         out.push_back(G::log(G::compose(G::template cast<T>(G::inverse(c.target)), b.g[j]))(comp - r));
         break;
       }
+      case ConditionKind::SecondOrderIncrement:
+        if constexpr (k >= 2) {
+          const int j = e == End::Initial ? 0 : 2 * k - 2, next = e == End::Initial ? 1 : 2 * k - 3;
+          const auto w = [&](int i) { return reduced_velocity_of(bvp.problem, b.p[i], b.p[i + 1], b.g[i], h)(comp - r); };
+          out.push_back((3.0 * w(j) - w(next)) / 2.0 - c.value);
+        }
+        break;
       case ConditionKind::SecondOrderVelocity:
         if (e == End::Initial)
           out.push_back((-3.0 * b.p[0](comp) + 4.0 * b.p[1](comp) - b.p[2](comp)) / (2.0 * h) - c.value);
