@@ -59,6 +59,7 @@ json describe(const ProblemDescriptor& d) {
   j["columns"] = {{"shape", d.shape}, {"velocity", d.velocity}, {"group", d.group}, {"omega", d.omega}, {"outputs", d.outputs}};
   j["schemes"] = scheme_names(d);
   if (d.paper_order > 0) j["paper_order"] = d.paper_order;
+  if (d.paper_derived) j["paper_derived"] = true;  // the paper's windows from the continuous model
   return j;
 }
 

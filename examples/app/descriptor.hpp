@@ -85,6 +85,9 @@ struct ProblemDescriptor {
   // The paper's nodal windows (METHOD.md §2) need a discrete form of the problem: its order k,
   // 0 when the problem has only the continuous form (Galerkin schemes only).
   int paper_order = 0;
+  // The paper's windows derived from the continuous model (ModelProblem, core/paper_windows.hpp)
+  // rather than a hand-written L_d: offered as a second-order reference, Galerkin stays the default.
+  bool paper_derived = false;
   std::vector<SchemeOption> paper_options;
   // The highest Galerkin order compiled in: 6, or 8 (ModelProblem<Model, 8> sets it).
   int galerkin_max_order = 6;

@@ -1,8 +1,10 @@
 // A problem given by its continuous model (core/continuous.hpp: ℓ, constraints χ, connection)
 // and a descriptor: everything the application does with it on the Galerkin schemes of order 4
-// and 6, and 8 with MaxOrder = 8 (METHOD.md §9) — boundary conditions from the scene, a guess,
-// the solve, the columns, the momentum — with nothing written per problem. A problem with a discrete form too (the
-// paper's windows) derives from it and overrides solve_paper and check_paper.
+// and 6, and 8 with MaxOrder = 8 (METHOD.md §9), and on the paper's nodal windows derived from the
+// model (core/paper_windows.hpp, model_problem_paper.hpp) — boundary conditions from the scene, a
+// guess, the solve, the columns, the momentum — with nothing written per problem. A problem with a
+// hand-written discrete form (the beanie's and the electron's L_d) sets DerivedPaper = false and
+// overrides solve_paper and check_paper.
 //
 //   const ModelProblem<MyModel> my_problem(my_descriptor(), [](const ParameterValues& v) { ... });
 //   LPSHOOT_REGISTER_PROBLEM(my_problem);
@@ -21,7 +23,7 @@
 
 namespace lpshoot::app {
 
-template <class Model, int MaxOrder = 6>
+template <class Model, int MaxOrder = 6, bool DerivedPaper = true>
 class ModelProblem : public Problem {
   static_assert(MaxOrder == 6 || MaxOrder == 8, "ModelProblem: the highest Galerkin order compiled in is 6 or 8");
 
@@ -33,10 +35,16 @@ class ModelProblem : public Problem {
   using Scheme = Galerkin<Model, S>;
   template <int S>
   using GuessFunction = std::function<GalerkinGuess<Scheme<S>>(const GalerkinBVP<Scheme<S>>&, const Scene&)>;
+  // The paper's nodal windows of order k = 2 derived from the model, with the symmetric jet.
+  using PaperScheme = PaperWindows<Model, WindowJet::Central>;
 
   ModelProblem(ProblemDescriptor descriptor, std::function<Model(const ParameterValues&)> make)
       : descriptor_(std::move(descriptor)), make_(std::move(make)) {
     descriptor_.galerkin_max_order = MaxOrder;
+    if (DerivedPaper && descriptor_.optimal_control && descriptor_.paper_order == 0) {
+      descriptor_.paper_order = PaperScheme::order;
+      descriptor_.paper_derived = true;
+    }
     const ProblemDescriptor& D = descriptor_;
     if (static_cast<int>(D.shape.size()) != r || static_cast<int>(D.velocity.size()) != r ||
         static_cast<int>(D.group.size()) != d || static_cast<int>(D.omega.size()) != d)
@@ -122,39 +130,53 @@ class ModelProblem : public Problem {
     return bvp;
   }
 
-  // A guess from the boundary data alone: each shape component by the cubic Hermite
-  // interpolant of its end values and velocities (a missing value: the other end's, or zero; a
-  // missing velocity: zero); the group on the one-parameter curve g_0 exp(t ξ), ξ the given
-  // Ω(0) components, or those that reach g(T) when both ends give the group, or zero;
-  // Ω = ξ + 𝒜(p) p'; zero bubbles and multipliers.
-  template <int S>
-  GalerkinGuess<Scheme<S>> default_guess(const GalerkinBVP<Scheme<S>>& bvp, const Scene& s) const {
-    const ProblemDescriptor& D = descriptor_;
-    const double T = bvp.T, h = bvp.h();
+  // The curve a guess follows, from the boundary data alone: each shape component by the cubic
+  // Hermite interpolant of its end values and velocities (a missing value: the other end's, or
+  // zero; a missing velocity: zero); the group on the one-parameter curve g_0 exp(t ξ), ξ the
+  // given Ω(0) components, or those that reach g(T) when both ends give the group, or zero.
+  struct BoundaryCurve {
+    double T = 0;
     Vec<double, r> x0, xT, v0, vT;
-    for (int i = 0; i < r; ++i) {
-      const auto a = boundary_component(D, s.start, NodePart::Shape, i), b = boundary_component(D, s.end, NodePart::Shape, i);
-      x0(i) = a ? *a : b ? *b : 0.0;
-      xT(i) = b ? *b : x0(i);
-      v0(i) = boundary_component(D, s.start, NodePart::Velocity, i).value_or(0.0);
-      vT(i) = boundary_component(D, s.end, NodePart::Velocity, i).value_or(0.0);
-    }
-    auto shape = [&](double t, bool derivative) {
+    Element g0;
+    Vec<double, d> xi;
+    Vec<double, r> shape(double t, bool derivative) const {
       const double u = t / T;
       if (!derivative)
-        return Vec<double, r>((2 * u * u * u - 3 * u * u + 1) * x0 + (u * u * u - 2 * u * u + u) * T * v0 +
-                              (-2 * u * u * u + 3 * u * u) * xT + (u * u * u - u * u) * T * vT);
-      return Vec<double, r>(((6 * u * u - 6 * u) * x0 + (3 * u * u - 4 * u + 1) * T * v0 + (-6 * u * u + 6 * u) * xT +
-                             (3 * u * u - 2 * u) * T * vT) /
-                            T);
-    };
+        return (2 * u * u * u - 3 * u * u + 1) * x0 + (u * u * u - 2 * u * u + u) * T * v0 + (-2 * u * u * u + 3 * u * u) * xT +
+               (u * u * u - u * u) * T * vT;
+      return ((6 * u * u - 6 * u) * x0 + (3 * u * u - 4 * u + 1) * T * v0 + (-6 * u * u + 6 * u) * xT + (3 * u * u - 2 * u) * T * vT) /
+             T;
+    }
+  };
+  BoundaryCurve boundary_curve(const Scene& s) const {
+    const ProblemDescriptor& D = descriptor_;
+    BoundaryCurve c;
+    c.T = s.T;
+    for (int i = 0; i < r; ++i) {
+      const auto a = boundary_component(D, s.start, NodePart::Shape, i), b = boundary_component(D, s.end, NodePart::Shape, i);
+      c.x0(i) = a ? *a : b ? *b : 0.0;
+      c.xT(i) = b ? *b : c.x0(i);
+      c.v0(i) = boundary_component(D, s.start, NodePart::Velocity, i).value_or(0.0);
+      c.vT(i) = boundary_component(D, s.end, NodePart::Velocity, i).value_or(0.0);
+    }
     const auto [c0, all0] = group_data(s.start);
     const auto [cT, allT] = group_data(s.end);
-    const Element g0 = GroupCoordinates<G>::element(c0);
-    Vec<double, d> xi = Vec<double, d>::Zero();
-    if (all0 && allT) xi = G::log(G::compose(G::inverse(g0), GroupCoordinates<G>::element(cT))) / T;
+    c.g0 = GroupCoordinates<G>::element(c0);
+    c.xi.setZero();
+    if (all0 && allT) c.xi = G::log(G::compose(G::inverse(c.g0), GroupCoordinates<G>::element(cT))) / s.T;
     for (int i = 0; i < d; ++i)
-      if (const auto w = boundary_component(D, s.start, NodePart::Omega, i)) xi(i) = *w;
+      if (const auto w = boundary_component(D, s.start, NodePart::Omega, i)) c.xi(i) = *w;
+    return c;
+  }
+
+  // A guess on the boundary curve: Ω = ξ + 𝒜(p) p'; zero bubbles and multipliers.
+  template <int S>
+  GalerkinGuess<Scheme<S>> default_guess(const GalerkinBVP<Scheme<S>>& bvp, const Scene& s) const {
+    const double h = bvp.h();
+    const BoundaryCurve c = boundary_curve(s);
+    const Vec<double, d> xi = c.xi;
+    auto shape = [&](double t, bool derivative) { return c.shape(t, derivative); };
+    const Element g0 = c.g0;
     const Model m = bvp.model;
     auto omega = [&](double t) { return Vec<double, d>(xi + connection_velocity(m, shape(t, false), shape(t, true))); };
     GalerkinGuess<Scheme<S>> guess;
@@ -178,13 +200,34 @@ class ModelProblem : public Problem {
   }
 
  protected:
-  // The paper's nodal windows; only problems with a discrete form have them (the scene reader
-  // rejects scheme.discretization "paper" for the others).
-  virtual RunRecord solve_paper(const Scene& s, const Progress&) const {
-    throw SceneError(s.file + ": scheme.discretization: problem \"" + descriptor_.name +
-                     "\" has only its continuous form; use \"galerkin\"");
+  // The paper's nodal windows: derived from the model (model_problem_paper.hpp), or the problem's
+  // hand-written discrete form (an override). A free motion has no optimal control to solve.
+  virtual RunRecord solve_paper(const Scene& s, const Progress& progress) const {
+    if constexpr (DerivedPaper) {
+      return solve_derived_paper(s, progress);
+    } else {
+      (void)progress;
+      throw SceneError(s.file + ": scheme.discretization: problem \"" + descriptor_.name +
+                       "\" has only its continuous form; use \"galerkin\"");
+    }
   }
-  virtual std::string check_paper(const Scene&) const { return ""; }
+  virtual std::string check_paper(const Scene& s) const {
+    if constexpr (DerivedPaper) return counting_error([&] { return paper_boundary_value_problem(s); });
+    (void)s;
+    return "";
+  }
+
+ public:
+  // The derived paper scheme's boundary value problem: positions with their velocities through
+  // the scene's closure (nodes 0, 1 and N-1, N), the group at the end nodes, Ω through the first
+  // (last) increments — to second order with the second-order closure (SecondOrderIncrement),
+  // g~ = exp(h Ω) with the paper's; a missing component gets its natural condition.
+  BoundaryValueProblem<PaperScheme> paper_boundary_value_problem(const Scene& s) const;
+  // The boundary curve on the nodes: p_n, g~_n = exp(h ξ) A(p_n, p_{n+1}), zero multipliers.
+  ShootingGuess<PaperScheme> paper_guess(const BoundaryValueProblem<PaperScheme>& bvp, const Scene& s) const;
+
+ protected:
+  RunRecord solve_derived_paper(const Scene& s, const Progress& progress) const;
 
  private:
   // The end's group coordinates (missing ones zero) and whether all of them are given.
@@ -238,9 +281,9 @@ double momentum_table(const std::vector<Vec<double, d>>& J, int N, const std::st
   return worst;
 }
 
-template <class Model, int MaxOrder>
+template <class Model, int MaxOrder, bool DerivedPaper>
 template <int S>
-RunRecord ModelProblem<Model, MaxOrder>::solve_galerkin(const Scene& s, const Progress& progress) const {
+RunRecord ModelProblem<Model, MaxOrder, DerivedPaper>::solve_galerkin(const Scene& s, const Progress& progress) const {
   using Sch = Scheme<S>;
   const ProblemDescriptor& D = descriptor_;
   RunRecord rec = start_record("solve", s);
@@ -310,3 +353,5 @@ RunRecord ModelProblem<Model, MaxOrder>::solve_galerkin(const Scene& s, const Pr
 }
 
 }  // namespace lpshoot::app
+
+#include "model_problem_paper.hpp"

@@ -8,7 +8,7 @@ namespace lpshoot::app {
 
 // The order-8 solve is compiled apart (problem_beanie_order8.cpp), in parallel with this file and
 // within the memory of orders 4 and 6 (one file with all three: 1.5x the time, 5.5 GB).
-extern template RunRecord ModelProblem<problems::BeanieModel, 8>::solve_galerkin<5>(const Scene&, const Progress&) const;
+extern template RunRecord ModelProblem<problems::BeanieModel, 8, false>::solve_galerkin<5>(const Scene&, const Progress&) const;
 
 const ProblemDescriptor& beanie_descriptor() {
   static const ProblemDescriptor d = [] {
@@ -44,7 +44,7 @@ const ProblemDescriptor& beanie_descriptor() {
 
 namespace {
 
-class BeanieProblem : public ModelProblem<problems::BeanieModel, 8> {
+class BeanieProblem : public ModelProblem<problems::BeanieModel, 8, false> {
  public:
   BeanieProblem()
       : ModelProblem(beanie_descriptor(), [](const ParameterValues& v) { return problems::BeanieModel{beanie_parameters(v)}; }) {

@@ -7,7 +7,7 @@ namespace lpshoot::app {
 
 // The order-8 solve is compiled apart (problem_electron_order8.cpp), in parallel with this file and
 // within the memory of orders 4 and 6 (one file with all three: 1.5x the time, 5.5 GB).
-extern template RunRecord ModelProblem<problems::ElectronModel, 8>::solve_galerkin<5>(const Scene&, const Progress&) const;
+extern template RunRecord ModelProblem<problems::ElectronModel, 8, false>::solve_galerkin<5>(const Scene&, const Progress&) const;
 namespace {
 
 ProblemDescriptor electron_descriptor() {
@@ -30,7 +30,7 @@ ProblemDescriptor electron_descriptor() {
   return d;
 }
 
-class ElectronProblem : public ModelProblem<problems::ElectronModel, 8> {
+class ElectronProblem : public ModelProblem<problems::ElectronModel, 8, false> {
  public:
   ElectronProblem()
       : ModelProblem(electron_descriptor(), [](const ParameterValues& v) { return problems::model_of(electron_of(v)); }) {

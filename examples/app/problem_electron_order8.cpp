@@ -5,6 +5,6 @@
 
 namespace lpshoot::app {
 
-template RunRecord ModelProblem<problems::ElectronModel, 8>::solve_galerkin<5>(const Scene&, const Progress&) const;
+template RunRecord ModelProblem<problems::ElectronModel, 8, false>::solve_galerkin<5>(const Scene&, const Progress&) const;
 
 }  // namespace lpshoot::app

@@ -632,7 +632,8 @@ Scene parse_scene(const json& j, const std::string& path) {
   read_parameters(root, *s.problem, s);
   if (s.is_optimal_control()) {
     read_boundary(root, s.problem->descriptor(), s);
-    if (s.problem->descriptor().paper_order == 0) s.discretization = Discretization::Galerkin;
+    if (s.problem->descriptor().paper_order == 0 || s.problem->descriptor().paper_derived)
+      s.discretization = Discretization::Galerkin;
     for (const auto& o : s.problem->descriptor().paper_options) s.scheme_options[o.key] = o.choices.front();
   } else {
     read_initial_data(root, s.problem->descriptor(), s);

@@ -144,6 +144,38 @@ TEST(Plugins, OscillatorFromItsOwnFileMatchesTheExactOptimum) {
   for (double p : orders["galerkin4"]) EXPECT_NEAR(p, 4.0, 0.25);
   for (double p : orders["galerkin6"]) EXPECT_NEAR(p, 6.0, 0.25);
 
+  // The paper's nodal windows derived from the plugin's model (core/paper_windows.hpp), with the
+  // second-order closure: second order against the exact optimum, positions and control.
+  std::vector<double> paper_x, paper_u;
+  for (int N : {40, 80, 160}) {
+    const fs::path out = work / ("paper" + std::to_string(N));
+    const Outcome pr = run_cli("solve" + problem + " '" + oscillator_scene + "' --set 'scheme={\"discretization\": \"paper\"}' --set horizon.N=" +
+                                   std::to_string(N) + " --no-plot --out '" + out.string() + "'",
+                               work);
+    ASSERT_EQ(pr.code, 0) << pr.out << pr.err;
+    std::vector<std::string> ph;
+    const auto prow = read_csv(out / "trajectory.csv", ph);
+    ASSERT_EQ(prow.size(), static_cast<size_t>(N + 1));
+    const int px1 = column(ph, "x1"), px2 = column(ph, "x2"), pu1 = column(ph, "u1"), pu2 = column(ph, "u2");
+    double ex = 0, eu = 0;
+    for (size_t n = 0; n < prow.size(); ++n) {
+      const auto& r = prow[n];
+      ex = std::max({ex, std::abs(r[px1] - exact[0].x(r[0])), std::abs(r[px2] - exact[1].x(r[0]))});
+      if (n == 0 || n + 1 == prow.size()) continue;  // the control lives on windows: nodes 1 .. N-1
+      eu = std::max({eu, std::abs(r[pu1] - exact[0].u(r[0])), std::abs(r[pu2] - exact[1].u(r[0]))});
+    }
+    std::printf("oscillator, derived paper windows, N = %d: x error %.3e, u error %.3e\n", N, ex, eu);
+    paper_x.push_back(ex);
+    paper_u.push_back(eu);
+    const json pj = json::parse(std::ifstream(out / "report.json"));
+    EXPECT_EQ(pj["scheme"], "paper");
+    EXPECT_EQ(pj["outputs_from"], "window_jets");
+  }
+  for (size_t i = 1; i < paper_x.size(); ++i) {
+    EXPECT_NEAR(std::log2(paper_x[i - 1] / paper_x[i]), 2.0, 0.15) << "x, halving " << i;
+    EXPECT_NEAR(std::log2(paper_u[i - 1] / paper_u[i]), 2.0, 0.2) << "u, halving " << i;
+  }
+
   // check, and the problem listed with its descriptor.
   const Outcome ck = run_cli("check" + problem + " '" + oscillator_scene + "'", work);
   EXPECT_EQ(ck.code, 0) << ck.err;
