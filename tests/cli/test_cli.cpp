@@ -559,7 +559,7 @@ TEST_F(BadInput, EachClassFailsCleanlyNamingTheKey) {
       {"galerkin_order_not_compiled", "solve " + sp + "--set scheme.order=8",
        "scheme.order: order 8 is not compiled into problem \"spherical_pendulum\" (its highest is 6"},
       {"sweep_scheme_not_compiled", "sweep " + sp + "--N 10,20 --scheme galerkin6,galerkin8",
-       "--scheme: 'galerkin8' is not a scheme of spherical_pendulum (galerkin4, galerkin6)"},
+       "--scheme: 'galerkin8' is not a scheme of spherical_pendulum (paper, galerkin4, galerkin6)"},
       {"closure_with_galerkin", "solve " + e + "--set scheme.discretization=galerkin",
        "scheme.closure: applies to the paper's discretization only"},
       {"order_with_paper", "solve " + e + "--set scheme.order=4", "scheme.order: applies to the galerkin discretization only"},

@@ -146,8 +146,9 @@ TEST(Plugins, OscillatorFromItsOwnFileMatchesTheExactOptimum) {
 
   // The paper's nodal windows derived from the plugin's model (core/paper_windows.hpp), with the
   // second-order closure: second order against the exact optimum, positions and control.
+  // Measured: x 2.13, 2.07; u 1.93, 1.97 (N = 40 -> 80 is still 2.22).
   std::vector<double> paper_x, paper_u;
-  for (int N : {40, 80, 160}) {
+  for (int N : {80, 160, 320}) {
     const fs::path out = work / ("paper" + std::to_string(N));
     const Outcome pr = run_cli("solve" + problem + " '" + oscillator_scene + "' --set 'scheme={\"discretization\": \"paper\"}' --set horizon.N=" +
                                    std::to_string(N) + " --no-plot --out '" + out.string() + "'",
@@ -173,7 +174,7 @@ TEST(Plugins, OscillatorFromItsOwnFileMatchesTheExactOptimum) {
   }
   for (size_t i = 1; i < paper_x.size(); ++i) {
     EXPECT_NEAR(std::log2(paper_x[i - 1] / paper_x[i]), 2.0, 0.15) << "x, halving " << i;
-    EXPECT_NEAR(std::log2(paper_u[i - 1] / paper_u[i]), 2.0, 0.2) << "u, halving " << i;
+    EXPECT_NEAR(std::log2(paper_u[i - 1] / paper_u[i]), 2.0, 0.15) << "u, halving " << i;
   }
 
   // check, and the problem listed with its descriptor.
