@@ -262,6 +262,26 @@ class ModelProblem : public Problem {
   std::string definition_error_;
 };
 
+// A model's run at nodes 0..N (t; shape x, group coordinates c, Ω w, velocities v, outputs, each
+// one vector per component): its columns in that order, the state columns (shape and group)
+// and the final state.
+inline void add_node_columns(const ProblemDescriptor& D, const std::vector<double>& t,
+                             const std::vector<std::vector<double>>& x, const std::vector<std::vector<double>>& c,
+                             const std::vector<std::vector<double>>& w, const std::vector<std::vector<double>>& v,
+                             const std::vector<std::vector<double>>& out, RunRecord& rec) {
+  auto add = [&](const std::vector<std::string>& names, const std::vector<std::vector<double>>& columns) {
+    for (size_t i = 0; i < names.size(); ++i) rec.trajectory.add(names[i], columns[i]);
+  };
+  auto final_values = [&](const std::vector<std::string>& names, const std::vector<std::vector<double>>& columns) {
+    for (size_t i = 0; i < names.size(); ++i) rec.final_state.emplace_back(names[i], columns[i].back());
+  };
+  rec.trajectory.add("t", t);
+  add(D.shape, x), add(D.group, c), add(D.omega, w), add(D.velocity, v), add(D.outputs, out);
+  rec.state_columns = D.shape;
+  rec.state_columns.insert(rec.state_columns.end(), D.group.begin(), D.group.end());
+  final_values(D.shape, x), final_values(D.velocity, v), final_values(D.group, c), final_values(D.omega, w);
+}
+
 // Columns PREFIX1.., PREFIX_drift of momenta given at nodes 0 .. J.size()-1 (empty cells after);
 // returns the max drift and J_0 through `J0`.
 template <int d>
@@ -325,18 +345,7 @@ RunRecord ModelProblem<Model, MaxOrder, DerivedPaper>::solve_galerkin(const Scen
       P.push_back(physical_momentum(m, g[n], q));
     }
   }
-  rec.trajectory.add("t", t);
-  for (int i = 0; i < r; ++i) rec.trajectory.add(D.shape[i], x[i]);
-  for (int i = 0; i < d; ++i) rec.trajectory.add(D.group[i], c[i]);
-  for (int i = 0; i < d; ++i) rec.trajectory.add(D.omega[i], w[i]);
-  for (int i = 0; i < r; ++i) rec.trajectory.add(D.velocity[i], v[i]);
-  for (size_t i = 0; i < D.outputs.size(); ++i) rec.trajectory.add(D.outputs[i], out[i]);
-  rec.state_columns = D.shape;
-  rec.state_columns.insert(rec.state_columns.end(), D.group.begin(), D.group.end());
-  for (int i = 0; i < r; ++i) rec.final_state.emplace_back(D.shape[i], x[i].back());
-  for (int i = 0; i < r; ++i) rec.final_state.emplace_back(D.velocity[i], v[i].back());
-  for (int i = 0; i < d; ++i) rec.final_state.emplace_back(D.group[i], c[i].back());
-  for (int i = 0; i < d; ++i) rec.final_state.emplace_back(D.omega[i], w[i].back());
+  add_node_columns(D, t, x, c, w, v, out, rec);
 
   if constexpr (d > 0) {  // J_n (n = 0..N-1): the scheme's discrete momentum map, conserved to roundoff
     const auto J = galerkin_spatial_momentum(m, tr);

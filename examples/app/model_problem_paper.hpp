@@ -129,18 +129,7 @@ RunRecord ModelProblem<Model, MaxOrder, DerivedPaper>::solve_derived_paper(const
     }
     rec.outputs_from = "window_jets";
   }
-  rec.trajectory.add("t", t);
-  for (int i = 0; i < r; ++i) rec.trajectory.add(D.shape[i], x[i]);
-  for (int i = 0; i < d; ++i) rec.trajectory.add(D.group[i], c[i]);
-  for (int i = 0; i < d; ++i) rec.trajectory.add(D.omega[i], w[i]);
-  for (int i = 0; i < r; ++i) rec.trajectory.add(D.velocity[i], v[i]);
-  for (size_t i = 0; i < D.outputs.size(); ++i) rec.trajectory.add(D.outputs[i], out[i]);
-  rec.state_columns = D.shape;
-  rec.state_columns.insert(rec.state_columns.end(), D.group.begin(), D.group.end());
-  for (int i = 0; i < r; ++i) rec.final_state.emplace_back(D.shape[i], x[i].back());
-  for (int i = 0; i < r; ++i) rec.final_state.emplace_back(D.velocity[i], v[i].back());
-  for (int i = 0; i < d; ++i) rec.final_state.emplace_back(D.group[i], c[i].back());
-  for (int i = 0; i < d; ++i) rec.final_state.emplace_back(D.omega[i], w[i].back());
+  add_node_columns(D, t, x, c, w, v, out, rec);
 
   if constexpr (d > 0) {  // J_n: the scheme's discrete momentum map, conserved to roundoff
     record_momentum(problem, tr, res.g.front(), rec);
