@@ -204,6 +204,20 @@ TEST(Plugins, OscillatorFromItsOwnFileMatchesTheExactOptimum) {
   const Outcome size = run_cli("check" + problem + " '" + oscillator_scene + "' --set boundary.final.velocity=[1]", work);
   EXPECT_EQ(size.code, 2);
   EXPECT_NE(size.err.find("boundary.final.velocity"), std::string::npos) << size.err;
+  // The derived paper windows: a velocity without its position cannot go through the paper's
+  // first-order closure (node 1 = x(0) + h v(0)); the message names both and the fix, and the
+  // second-order closure takes the same data.
+  const std::string no_position = " --set boundary.initial.position=null";
+  const Outcome closure = run_cli("check" + problem + " '" + oscillator_scene +
+                                      "' --set 'scheme={\"discretization\": \"paper\", \"closure\": \"paper\"}'" + no_position,
+                                  work);
+  EXPECT_EQ(closure.code, 2);
+  EXPECT_NE(closure.err.find("initial v1 is given without initial x1"), std::string::npos) << closure.err;
+  EXPECT_NE(closure.err.find("scheme.closure \"second_order\""), std::string::npos) << closure.err;
+  const Outcome second_order = run_cli("check" + problem + " '" + oscillator_scene + "' --set 'scheme={\"discretization\": \"paper\"}'" +
+                                     no_position,
+                                 work);
+  EXPECT_EQ(second_order.code, 0) << second_order.err;
   // Without --problem, the scene's problem is unknown, and the message says how to load it.
   const Outcome missing = run_cli("check '" + oscillator_scene + "'", work);
   EXPECT_EQ(missing.code, 2);
