@@ -49,10 +49,11 @@ T action_sum(const P& problem, const NodeBlock<P, T>& b, int first, int last, do
   return S;
 }
 
-// E_c (r + d entries: δp part, then η part) over windows first..last, all containing node c.
+// The block lifted to Dual<TO, r + d> with node c perturbed by (δp, η) in those directions
+// (the increments in windows first..last move; see the file comment).
 template <class P, class TO>
-Vec<TO, Dims<P>::node> node_residual(const P& problem, const NodeBlock<P, TO>& block, int c,
-                                     int first, int last, double h) {
+NodeBlock<P, Dual<TO, Dims<P>::node>> perturbed_node_block(const P& problem, const NodeBlock<P, TO>& block, int c,
+                                                          int first, int last) {
   using D = Dims<P>;
   using G = typename P::Group;
   using TI = Dual<TO, D::node>;
@@ -82,10 +83,16 @@ Vec<TO, Dims<P>::node> node_residual(const P& problem, const NodeBlock<P, TO>& b
       b.g[c] = G::compose(b.g[c], connection(problem, pc, b.p[c + 1]));
   }
   b.p[c] = pc;
+  return b;
+}
 
-  const TI S = action_sum(problem, b, first, last, h);
-  Vec<TO, D::node> E;
-  for (int i = 0; i < D::node; ++i) E(i) = S.d[i];
+// E_c (r + d entries: δp part, then η part) over windows first..last, all containing node c.
+template <class P, class TO>
+Vec<TO, Dims<P>::node> node_residual(const P& problem, const NodeBlock<P, TO>& block, int c,
+                                     int first, int last, double h) {
+  const auto S = action_sum(problem, perturbed_node_block(problem, block, c, first, last), first, last, h);
+  Vec<TO, Dims<P>::node> E;
+  for (int i = 0; i < Dims<P>::node; ++i) E(i) = S.d[i];
   return E;
 }
 

@@ -83,6 +83,55 @@ struct PaperWindows {
   Vec<T, num_constraints> constraints(const Window<PaperWindows, T>& a, double h) const {
     return model_constraints(model, jet(a, h));
   }
+  // The natural boundary conditions' missing half window (METHOD.md §9 "Natural conditions of
+  // the windows"). The windows' sum is a midpoint rule on [h/2, T − h/2]: its truncated node
+  // residuals at a free end are the continuous natural conditions at h/2, first order. With
+  // G = ∇(h ℓ + λ·χ) in the jet's p, p', Ω at the end window (frozen: end_slopes), adding to
+  // a free end node's residual the gradient of
+  //   K = ½ [G_p·p_e + G_p'·(p_{e+} − p_{e−})/h + G_Ω·ω_e]
+  // (e the end node, (p_{e−}, p_{e+}) and ω_e the end interval's nodes and velocity) restores
+  // what the linearized ∫ over [0, h/2] (or [T − h/2, T]) contributes. By Taylor expansion the
+  // rows become π₂ = ℓ̃_p'' and π₁ = ℓ̃_p' − (ℓ̃_p'')' at the end (and for Ω: ℓ̃_Ω' and the
+  // momentum) to O(h²). Central jet only: the forward jet is first order anyway.
+  static constexpr bool has_half_window = J == WindowJet::Central;
+  template <class T>
+  struct Slopes {
+    Vec<T, shape_dim> p, dp;
+    Vec<T, Group::dim> Omega;
+  };
+  template <class T>
+  Slopes<T> end_slopes(const Window<PaperWindows, T>& a, const Vec<T, num_constraints>& lam, double h) const {
+    constexpr int r = shape_dim, d = Group::dim;
+    using TD = Dual<T, 2 * r + d>;
+    const Jet<C, T> q = jet(a, h);
+    Jet<C, TD> x;
+    x.p = q.p.template cast<TD>(), x.dp = q.dp.template cast<TD>(), x.ddp = q.ddp.template cast<TD>();
+    x.Omega = q.Omega.template cast<TD>(), x.dOmega = q.dOmega.template cast<TD>();
+    for (int i = 0; i < r; ++i) x.p(i) = TD::variable(q.p(i), i), x.dp(i) = TD::variable(q.dp(i), r + i);
+    for (int i = 0; i < d; ++i) x.Omega(i) = TD::variable(q.Omega(i), 2 * r + i);
+    TD L = h * model.template lagrangian<TD>(x);
+    if constexpr (num_constraints > 0) {
+      const Vec<TD, num_constraints> chi = model_constraints(model, x);
+      for (int i = 0; i < num_constraints; ++i) L = L + TD(lam(i)) * chi(i);
+    }
+    Slopes<T> s;
+    for (int i = 0; i < r; ++i) s.p(i) = L.d[i], s.dp(i) = L.d[r + i];
+    for (int i = 0; i < d; ++i) s.Omega(i) = L.d[2 * r + i];
+    return s;
+  }
+  // K on the end window a (the first window for the initial end, the last for the terminal).
+  template <class T, class S>
+  T half_window(const Window<PaperWindows, T>& a, const Slopes<S>& s, bool initial, double h) const {
+    const int e = initial ? 0 : 2, lo = initial ? 0 : 1;
+    T K = T(0.0);
+    for (int i = 0; i < shape_dim; ++i) K = K + T(s.p(i)) * a.p[e](i) + T(s.dp(i)) * (a.p[lo + 1](i) - a.p[lo](i)) / h;
+    if constexpr (Group::dim > 0) {
+      const Vec<T, Group::dim> w = reduced_velocity(a.p[lo], a.p[lo + 1], a.g[lo], h);
+      for (int i = 0; i < Group::dim; ++i) K = K + T(s.Omega(i)) * w(i);
+    }
+    return 0.5 * K;
+  }
+
   // Only when the model has a connection form (otherwise the bundle is trivial: problem.hpp).
   template <class T, class CC = C, std::enable_if_t<detail::HasConnectionForm<CC, T>::value, int> = 0>
   typename Group::template Element<T> connection(const Vec<T, shape_dim>& p0, const Vec<T, shape_dim>& p1) const {

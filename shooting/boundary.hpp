@@ -126,6 +126,37 @@ struct BoundaryState {
   static constexpr int size = Dims<P>::state + P::Group::dim;
 };
 
+namespace detail {
+template <class P, class = void>
+struct HasHalfWindow : std::false_type {};
+template <class P>
+struct HasHalfWindow<P, std::enable_if_t<P::has_half_window>> : std::true_type {};
+}  // namespace detail
+
+// Whether the second node of end e has a condition on component comp other than its natural one
+// (a velocity through a closure, an increment, Ω).
+template <class P>
+bool velocity_given(const BoundaryValueProblem<P>& bvp, End e, int comp) {
+  for (const auto& c : bvp.conditions)
+    if (c.end == e && c.offset == 1 && c.component == comp && c.kind != ConditionKind::Natural) return true;
+  return false;
+}
+
+// The gradient of the problem's half window K at one end (core/paper_windows.hpp) over the
+// perturbation of the block's node n, in the increments of windows first..last.
+template <class P, class T>
+Vec<T, Dims<P>::node> half_window_gradient(const BoundaryValueProblem<P>& bvp, End e, const NodeBlock<P, T>& b, int n,
+                                           int first, int last) {
+  const int w = e == End::Initial ? 0 : P::order - 1;  // the end window
+  const double h = bvp.h();
+  const auto slopes = bvp.problem.end_slopes(b.window(w), b.lam[w], h);
+  const auto moved = perturbed_node_block(bvp.problem, b, n, first, last);
+  const auto K = bvp.problem.half_window(moved.window(w), slopes, e == End::Initial, h);
+  Vec<T, Dims<P>::node> out;
+  for (int i = 0; i < Dims<P>::node; ++i) out(i) = K.d[i];
+  return out;
+}
+
 // Residuals of the conditions at one end, in scalar T (a Dual for Jacobians). For the initial
 // end the k m initial constraints chi_d(a_0 .. a_{k-1}) come first.
 template <class P, class T>
@@ -179,9 +210,20 @@ std::vector<T> boundary_residuals(const BoundaryValueProblem<P>& bvp, End e, con
         break;
       case ConditionKind::Natural: {
         // Windows that exist and contain the node: initial [0, node], terminal [node-k, k-1].
-        const int first = e == End::Initial ? 0 : node - k;
-        const int last = e == End::Initial ? node : k - 1;
-        out.push_back(node_residual(bvp.problem, b, node, first, last, h)(comp));
+        const auto residual = [&](int n) {
+          const int first = e == End::Initial ? 0 : n - k, last = e == End::Initial ? n : k - 1;
+          T row = node_residual(bvp.problem, b, n, first, last, h)(comp);
+          if constexpr (detail::HasHalfWindow<P>::value) row = row + half_window_gradient(bvp, e, b, n, first, last)(comp);
+          return row;
+        };
+        T row = residual(node);
+        // With the half window, a free end value (position, group element) whose velocity (Ω)
+        // is given varies the end's first two nodes together: the row is the sum of their
+        // residuals, π₁ (the momentum) at the end. Alone, node 0's residual is ℓ̃_p''/h − π₁ +
+        // O(1), which holds only where ℓ̃_p'' vanishes.
+        if constexpr (detail::HasHalfWindow<P>::value)
+          if (c.offset == 0 && velocity_given(bvp, e, comp)) row = row + residual(e == End::Initial ? 1 : 2 * k - 2);
+        out.push_back(row);
         break;
       }
     }

@@ -328,13 +328,13 @@ TEST(ModelProblems, SphericalPendulumFromOneFileSolvesAndConservesItsAngularMome
   for (size_t i : {1, 2, 5, 6}) EXPECT_NEAR(sw["runs"][i]["order"].get<double>(), i < 4 ? 4.0 : 6.0, 0.2) << sw["runs"][i].dump();
 
   // The paper's nodal windows derived from the model (core/paper_windows.hpp). Ω is free at both
-  // ends, so its natural conditions make the multiplier vanish there; the windows' sum is a
-  // rectangle rule on [h/2, T - h/2] and those conditions sit half a step off: the trajectory is
-  // first order here (README). What the scheme does keep: its discrete momentum map to roundoff
-  // (one segment), θ(T), and the mechanical momentum P = m l² sin²φ Ω (the constraint) to second
-  // order. Measured: P drift 5.45e-4, 1.34e-4 (order 2.02); J drift 5e-13, 3e-13.
-  std::vector<double> p_drift;
-  for (int N : {40, 80}) {
+  // ends and its natural conditions carry the multiplier: second order only with the windows'
+  // half window (without it: orders 0.2 … 0.9 from N = 20 to 320). Measured against this
+  // Galerkin 6 run on its nodes: φ 5.7e-4, 1.4e-4, 3.6e-5 (orders 1.98, 1.99), Ω 2.8e-3,
+  // 6.8e-4, 1.7e-4 (2.02, 2.01). Also kept: the discrete momentum map to roundoff,
+  // θ(T), and the mechanical momentum P = m l² sin²φ Ω (the constraint) to second order.
+  std::vector<double> p_drift, phi_error, omega_error;
+  for (int N : {40, 80, 160}) {
     const fs::path paper_out = work / ("paper" + std::to_string(N));
     const Outcome paper = run_cli("solve '" + scene("spherical_pendulum") + "' --set 'scheme={\"discretization\": \"paper\"}' --set horizon.N=" +
                                       std::to_string(N) + " --no-plot --out '" + paper_out.string() + "'", work);
@@ -342,15 +342,33 @@ TEST(ModelProblems, SphericalPendulumFromOneFileSolvesAndConservesItsAngularMome
     const json pr = json::parse(std::ifstream(paper_out / "report.json"));
     EXPECT_EQ(pr["scheme"], "paper");
     EXPECT_EQ(pr["closure"], "second_order");
-    EXPECT_LT(pr["momentum_drift_relative"].get<double>(), 1e-12);
+    // One segment up to N = 80 (auto): the flow's roundoff (measured 2.8e-12, 7.0e-13); at N = 160
+    // two segments join within the solver's tolerance.
+    if (N <= 80) EXPECT_LT(pr["momentum_drift_relative"].get<double>(), 1e-11);
     p_drift.push_back(pr["physical_momentum_drift"].get<double>());
     std::vector<std::string> ph;
     const auto prow = read_csv(paper_out / "trajectory.csv", ph);
     ASSERT_EQ(ph, (std::vector<std::string>{"t", "phi", "theta", "Omega", "phi_dot", "u"}));
+    ASSERT_EQ(prow.size(), static_cast<size_t>(N + 1));
     EXPECT_NEAR(prow.back()[1], 1.0, 1e-10);
     EXPECT_NEAR(prow.back()[2], 1.5, 1e-10);
+    double ephi = 0, eomega = 0;
+    for (size_t n = 0; n < rows.size(); ++n) {
+      const auto& q = prow[n * (N / 40)];
+      ephi = std::max(ephi, std::abs(q[1] - rows[n][1]));
+      eomega = std::max(eomega, std::abs(q[3] - rows[n][3]));
+    }
+    phi_error.push_back(ephi);
+    omega_error.push_back(eomega);
+    std::printf("spherical pendulum, derived paper windows, N = %d: phi error %.3e, Omega error %.3e, P drift %.3e, J drift %.1e\n", N,
+                ephi, eomega, p_drift.back(), pr["momentum_drift_relative"].get<double>());
   }
-  EXPECT_NEAR(std::log2(p_drift[0] / p_drift[1]), 2.0, 0.15);
+  for (size_t i = 1; i < phi_error.size(); ++i) {
+    EXPECT_NEAR(std::log2(phi_error[i - 1] / phi_error[i]), 2.0, 0.15) << "phi, halving " << i;
+    EXPECT_NEAR(std::log2(omega_error[i - 1] / omega_error[i]), 2.0, 0.15) << "Omega, halving " << i;
+  }
+  for (size_t i = 1; i < p_drift.size(); ++i) EXPECT_NEAR(std::log2(p_drift[i - 1] / p_drift[i]), 2.0, 0.2) << "P drift, halving " << i;
+
 }
 
 // Order 8 (quintic, two bubbles, four Gauss points; METHOD.md §9) on both paper examples: the
