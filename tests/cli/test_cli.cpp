@@ -369,6 +369,21 @@ TEST(ModelProblems, SphericalPendulumFromOneFileSolvesAndConservesItsAngularMome
   }
   for (size_t i = 1; i < p_drift.size(); ++i) EXPECT_NEAR(std::log2(p_drift[i - 1] / p_drift[i]), 2.0, 0.2) << "P drift, halving " << i;
 
+  // One segment of 80 steps at tolerance 1e-11: the first full Newton step from the boundary
+  // curve raises the residual and the line search crawls (5.8e8 x tolerance after 49
+  // iterations), far above the scheme's roundoff floor (1.6e4 x tolerance). The message says so
+  // and names the remedy, which works: two segments converge in 4 iterations.
+  const std::string tight = "solve '" + scene("spherical_pendulum") +
+                            "' --set 'scheme={\"discretization\": \"paper\"}' --set horizon.N=80 --set solver.tolerance=1e-11 --no-plot ";
+  const Outcome one = run_cli(tight + "--set solver.segments=1 --out '" + (work / "one").string() + "'", work);
+  EXPECT_EQ(one.code, 1) << one.out << one.err;
+  const json fr = json::parse(std::ifstream(work / "one" / "report.json"));
+  const std::string why = fr["message"];
+  EXPECT_EQ(why.find("roundoff floor"), std::string::npos) << why;
+  EXPECT_NE(why.find("more segments"), std::string::npos) << why;
+  const Outcome two = run_cli(tight + "--set solver.segments=2 --out '" + (work / "two").string() + "'", work);
+  ASSERT_EQ(two.code, 0) << two.out << two.err;
+  EXPECT_NEAR(json::parse(std::ifstream(work / "two" / "report.json"))["final_state"]["theta"].get<double>(), 1.5, 1e-10);
 }
 
 // Order 8 (quintic, two bubbles, four Gauss points; METHOD.md §9) on both paper examples: the
