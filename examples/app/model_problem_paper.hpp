@@ -91,6 +91,10 @@ RunRecord ModelProblem<Model, MaxOrder, DerivedPaper>::solve_derived_paper(const
   const P problem{model(s)};
   const int N = s.N;
   const double h = tr.h;
+  // The cost: the windows' sum is a midpoint rule on [h/2, T − h/2] (first order in the cost);
+  // half of each end window stands for the missing [0, h/2] and [T − h/2, T], which makes it a
+  // trapezoidal rule to O(h²). The action (Σ L_d, what the scheme makes stationary) is kept.
+  rec.cost = res.cost + 0.5 * (problem.lagrangian(tr.window_at(0), h) + problem.lagrangian(tr.window_at(N - P::order), h));
   // Node values of the scheme's order (2): velocities and Ω by central differences inside,
   // one-sided at the ends; Ω from the increments' reduced velocities ω_j (at t_{j+1/2}).
   std::vector<Vec<double, d>> w_inc;
