@@ -83,8 +83,8 @@ struct PaperWindows {
   Vec<T, num_constraints> constraints(const Window<PaperWindows, T>& a, double h) const {
     return model_constraints(model, jet(a, h));
   }
-  // The natural boundary conditions' missing half window (METHOD.md §9 "Natural conditions of
-  // the windows"). The windows' sum is a midpoint rule on [h/2, T − h/2]: its truncated node
+  // The natural boundary conditions' missing half window (bench/RESULTS.md, "Second-order
+  // natural conditions on the derived windows"). The windows' sum is a midpoint rule on [h/2, T − h/2]: its truncated node
   // residuals at a free end are the continuous natural conditions at h/2, first order. With
   // G = ∇(h ℓ + λ·χ) in the jet's p, p', Ω at the end window (frozen: end_slopes), adding to
   // a free end node's residual the gradient of
