@@ -10,6 +10,8 @@
 
 #include <lpshoot/core/lpshoot.hpp>
 
+#include <algorithm>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -142,18 +144,20 @@ bool velocity_given(const BoundaryValueProblem<P>& bvp, End e, int comp) {
   return false;
 }
 
-// The gradient of the problem's half window K at one end (core/paper_windows.hpp) over the
-// perturbation of the block's node n, in the increments of windows first..last.
-template <class P, class T>
-Vec<T, Dims<P>::node> half_window_gradient(const BoundaryValueProblem<P>& bvp, End e, const NodeBlock<P, T>& b, int n,
-                                           int first, int last) {
-  const int w = e == End::Initial ? 0 : P::order - 1;  // the end window
+// The natural residual of the block's node n over windows first..last (those that exist and
+// contain it): the action's gradient in the node's perturbation, plus, for a problem with a half
+// window (core/paper_windows.hpp), the gradient of the missing half window K at end e, taken on
+// the same perturbed block. `slopes` are the end window's (end_slopes), or null without a half window.
+template <class P, class T, class Slopes>
+Vec<T, Dims<P>::node> natural_residual(const BoundaryValueProblem<P>& bvp, End e, const NodeBlock<P, T>& b, int n,
+                                       int first, int last, const Slopes* slopes) {
   const double h = bvp.h();
-  const auto slopes = bvp.problem.end_slopes(b.window(w), b.lam[w], h);
   const auto moved = perturbed_node_block(bvp.problem, b, n, first, last);
-  const auto K = bvp.problem.half_window(moved.window(w), slopes, e == End::Initial, h);
+  auto S = action_sum(bvp.problem, moved, first, last, h);
+  if constexpr (detail::HasHalfWindow<P>::value)
+    S = S + bvp.problem.half_window(moved.window(e == End::Initial ? 0 : P::order - 1), *slopes, e == End::Initial, h);
   Vec<T, Dims<P>::node> out;
-  for (int i = 0; i < Dims<P>::node; ++i) out(i) = K.d[i];
+  for (int i = 0; i < Dims<P>::node; ++i) out(i) = S.d[i];
   return out;
 }
 
@@ -178,6 +182,18 @@ std::vector<T> boundary_residuals(const BoundaryValueProblem<P>& bvp, End e, con
   std::vector<GroupElement<P, T>> g{g_first};
   for (int c = 0; c + 1 < 2 * k; ++c)
     g.push_back(G::compose(g.back(), G::compose(b.g[c], G::inverse(connection(bvp.problem, b.p[c], b.p[c + 1])))));
+  // The end window's slopes for the half window, once per end (natural_residual).
+  const auto slopes = [&] {
+    if constexpr (detail::HasHalfWindow<P>::value) {
+      const int w = e == End::Initial ? 0 : k - 1;
+      const bool natural = std::any_of(bvp.conditions.begin(), bvp.conditions.end(), [&](const auto& c) {
+        return c.end == e && c.kind == ConditionKind::Natural;
+      });
+      return natural ? std::optional(bvp.problem.end_slopes(b.window(w), b.lam[w], h)) : std::nullopt;
+    } else {
+      return std::optional<int>();
+    }
+  }();
   for (const auto& c : bvp.conditions) {
     if (c.end != e) continue;
     const int node = e == End::Initial ? c.offset : 2 * k - 1 - c.offset;  // local index
@@ -212,9 +228,7 @@ std::vector<T> boundary_residuals(const BoundaryValueProblem<P>& bvp, End e, con
         // Windows that exist and contain the node: initial [0, node], terminal [node-k, k-1].
         const auto residual = [&](int n) {
           const int first = e == End::Initial ? 0 : n - k, last = e == End::Initial ? n : k - 1;
-          T row = node_residual(bvp.problem, b, n, first, last, h)(comp);
-          if constexpr (detail::HasHalfWindow<P>::value) row = row + half_window_gradient(bvp, e, b, n, first, last)(comp);
-          return row;
+          return natural_residual(bvp, e, b, n, first, last, slopes ? &*slopes : nullptr)(comp);
         };
         T row = residual(node);
         // With the half window, a free end value (position, group element) whose velocity (Ω)
