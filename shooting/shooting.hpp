@@ -38,6 +38,10 @@ struct ShootingOptions {
   NewtonOptions step;
   double rank_tolerance = 1e-10;  // singular values of the equilibrated Jacobian below this times the largest count as zero
   int threads = 0;               // 0: one per available core
+  // When a solve does not converge for a reason more segments address (Newton did not bring the
+  // residual down from the guess, or the flow failed from it), solve again with twice the
+  // segments, at most this many times. -1: 2 when segments is auto (0), none for a given count.
+  int segment_doublings = -1;
   // Called as segments are propagated within one evaluation (segment done, of S): progress for
   // evaluations that take long (large N); may throw to stop the solve.
   std::function<void(int, int)> on_segment;
@@ -69,6 +73,8 @@ struct ShootingResult {
   double momentum_drift = 0;               // relative max |J_n - J_first| of the discrete momentum map
   bool propagated_starts = false;          // multiple shooting started from the forward sweep
   bool stalled_at_floor = false;           // not converged: stalled at the flows' roundoff floor
+  int segments = 0;                        // the segment count of this attempt (1: single shooting)
+  std::vector<int> failed_segment_counts;  // earlier attempts with fewer segments (segment_doublings)
   bool ok() const { return status == ShootingStatus::Converged; }
 };
 
@@ -219,6 +225,45 @@ ShootingResult<X> solve_from_starts(const typename SchemeFor<X>::BVP& bvp,
 }
 
 
+// One attempt with S segments of (nearly) equal length, started from the guess: from the guess's
+// states at the segment starts, or the forward sweep's (opt.segment_starts).
+template <class X>
+ShootingResult<X> solve_with_segments(const typename SchemeFor<X>::BVP& bvp, const typename SchemeFor<X>::Guess& guess,
+                                      int S, const ShootingOptions& opt) {
+  using A = SchemeFor<X>;
+  const int first = A::first_state(bvp), last = A::last_state(bvp);
+  std::vector<int> starts;
+  for (int i = 0; i <= S; ++i) starts.push_back(first + static_cast<int>(std::lround(double(last - first) * i / S)));
+  const auto refs = A::states(bvp, guess, std::vector<int>(starts.begin(), starts.end() - 1));
+
+  const bool sweep_first = S > 1 && opt.segment_starts == SegmentStarts::Propagated;
+  ShootingResult<X> out = solve_from_starts<X>(bvp, sweep_first ? forward_sweep<X>(bvp, refs, starts, opt.step) : refs, starts, opt);
+  out.propagated_starts = sweep_first;
+  // Auto: when the guess's interior states did not lead to a solution, the forward sweep's may
+  // (a stiff potential: the guess is far from the dynamics; an unstable flow: the sweep is not).
+  // Not after a stall at the flows' roundoff floor (stalled_at_floor): that floor belongs to the
+  // grid and the segments, not to the starts (the beanie at N = 10^6: ~17 minutes per attempt).
+  if (S > 1 && opt.segment_starts == SegmentStarts::Auto && out.status == ShootingStatus::NotConverged &&
+      !out.stalled_at_floor) {
+    ShootingResult<X> swept = solve_from_starts<X>(bvp, forward_sweep<X>(bvp, refs, starts, opt.step), starts, opt);
+    swept.propagated_starts = true;
+    swept.iterations += out.iterations;
+    // The better attempt's sentence stands; both accounts go to the detail.
+    auto account = [](const char* from, const ShootingResult<X>& r) {
+      return std::string("from ") + from + ": " + r.message + (r.detail.empty() ? "" : " [" + r.detail + "]");
+    };
+    if (swept.ok() || (swept.status == ShootingStatus::NotConverged && swept.residual_norm < out.residual_norm)) {
+      swept.detail = swept.ok() ? "" : account("the forward sweep's segment starts", swept) + "; " +
+                                           account("the guess's segment starts", out);
+      out = std::move(swept);
+    } else {
+      out.detail = account("the guess's segment starts", out) + "; " + account("the forward sweep's segment starts", swept);
+    }
+  }
+  out.segments = S;
+  return out;
+}
+
 }  // namespace detail
 
 // Solves the boundary value problem from a guess (e.g. interpolation of the boundary data, a
@@ -234,39 +279,36 @@ ShootingResult<X> solve_bvp_with(const typename SchemeFor<X>::BVP& bvp, const ty
     out.message = why;
     return out;
   }
-  // Segment starts (state indices) and reference states from the guess.
   const int first = A::first_state(bvp), last = A::last_state(bvp);
-  const int wanted = opt.segments > 0 ? opt.segments : auto_segments(bvp.N);
-  const int S = opt.method == ShootingMethod::Single ? 1 : std::max(1, std::min(wanted, last - first));
-  std::vector<int> starts;
-  for (int i = 0; i <= S; ++i) starts.push_back(first + static_cast<int>(std::lround(double(last - first) * i / S)));
-  const auto refs = A::states(bvp, guess, std::vector<int>(starts.begin(), starts.end() - 1));
-
-  const bool sweep_first = S > 1 && opt.segment_starts == SegmentStarts::Propagated;
-  ShootingResult<X> out =
-      detail::solve_from_starts<X>(bvp, sweep_first ? detail::forward_sweep<X>(bvp, refs, starts, opt.step) : refs, starts, opt);
-  out.propagated_starts = sweep_first;
-  // Auto: when the guess's interior states did not lead to a solution, the forward sweep's may
-  // (a stiff potential: the guess is far from the dynamics; an unstable flow: the sweep is not).
-  // Not after a stall at the flows' roundoff floor (stalled_at_floor): that floor belongs to the
-  // grid and the segments, not to the starts (the beanie at N = 10^6: ~17 minutes per attempt).
-  if (S > 1 && opt.segment_starts == SegmentStarts::Auto && out.status == ShootingStatus::NotConverged &&
-      !out.stalled_at_floor) {
-    ShootingResult<X> swept = detail::solve_from_starts<X>(bvp, detail::forward_sweep<X>(bvp, refs, starts, opt.step), starts, opt);
-    swept.propagated_starts = true;
-    swept.iterations += out.iterations;
-    // The better attempt's sentence stands; both accounts go to the detail.
-    auto account = [](const char* from, const ShootingResult<X>& r) {
-      return std::string("from ") + from + ": " + r.message + (r.detail.empty() ? "" : " [" + r.detail + "]");
-    };
-    if (swept.ok() || (swept.status == ShootingStatus::NotConverged && swept.residual_norm < out.residual_norm)) {
-      swept.detail = swept.ok() ? "" : account("the forward sweep's segment starts", swept) + "; " +
-                                           account("the guess's segment starts", out);
-      out = std::move(swept);
-    } else {
-      out.detail = account("the guess's segment starts", out) + "; " + account("the forward sweep's segment starts", swept);
-    }
+  const int most = std::max(1, last - first);  // one step per segment at most
+  int S = opt.method == ShootingMethod::Single ? 1
+                                              : std::min(most, opt.segments > 0 ? opt.segments : auto_segments(bvp.N));
+  const int doublings = opt.method == ShootingMethod::Single ? 0
+                        : opt.segment_doublings >= 0   ? opt.segment_doublings
+                        : opt.segments > 0             ? 0
+                                                       : 2;
+  ShootingResult<X> out = detail::solve_with_segments<X>(bvp, guess, S, opt);
+  // More segments when Newton did not converge from the guess for a reason they address: it
+  // did not bring the residual down (a long segment amplifies the guess's error; the spherical
+  // pendulum's windows on one 80-step segment at 1e-11 crawl for 49 iterations, two segments
+  // converge in 4), or the flow failed from the guess. Not after a stall at the roundoff floor
+  // (finer segments do not lower it much, and a large solve would pay twice), nor for a rank
+  // deficient Jacobian (the data are dependent).
+  auto addressed = [](const ShootingResult<X>& r) {
+    return (r.status == ShootingStatus::NotConverged && !r.stalled_at_floor) || r.status == ShootingStatus::FlowFailed;
+  };
+  std::string earlier;
+  for (int d = 0; d < doublings && S < most && addressed(out); ++d) {
+    earlier += (earlier.empty() ? "" : "; ") + std::string("with ") + std::to_string(S) + (S == 1 ? " segment: " : " segments: ") +
+               out.message + (out.detail.empty() ? "" : " [" + out.detail + "]");
+    S = std::min(most, 2 * S);
+    ShootingResult<X> more = detail::solve_with_segments<X>(bvp, guess, S, opt);
+    more.iterations += out.iterations;
+    more.failed_segment_counts = out.failed_segment_counts;
+    more.failed_segment_counts.push_back(out.segments);
+    out = std::move(more);
   }
+  if (!earlier.empty()) out.detail = (out.detail.empty() ? "" : out.detail + "; ") + "earlier attempts " + earlier;
   out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }

@@ -90,10 +90,14 @@ SweepRecord run_sweep(const Scene& scene, const std::string& command, const Swee
           s.shooting.method = m;
           s.shooting.solver.backend = b;
           int segments = scene.shooting.segments;
-          if (opt.steps_per_segment > 0)  // ceil(N / steps), without overflowing int
+          if (opt.steps_per_segment > 0) {  // ceil(N / steps), without overflowing int; kept as given
             segments = static_cast<int>((static_cast<long long>(N) + opt.steps_per_segment - 1) / opt.steps_per_segment);
-          else if (scene.auto_segments || scene.shooting.method == ShootingMethod::Single)
+            s.shooting.segment_doublings = 0;
+          }
+          else if (scene.auto_segments || scene.shooting.method == ShootingMethod::Single) {
             segments = s.default_segments(N);  // per grid (a single-shooting scene: multiple shooting's default)
+            s.shooting.segment_doublings = 2;  // as "auto" does (scene.cpp)
+          }
           s.shooting.segments = std::clamp(segments, 1, s.max_segments(N));
           sr.scheme = s.scheme_name();
           sr.method = method_name(m);
@@ -113,6 +117,7 @@ SweepRecord run_sweep(const Scene& scene, const std::string& command, const Swee
     const RunRecord& r = full.back();
     SweepRun& sr = p.run;
     sr.converged = r.converged;
+    sr.segments = r.segments;  // "auto" may have doubled the planned count
     sr.status = r.status;
     sr.message = r.message;
     sr.iterations = r.iterations;

@@ -386,7 +386,23 @@ TEST(ModelProblems, SphericalPendulumFromOneFileSolvesAndConservesItsAngularMome
   EXPECT_NE(why.find("more segments"), std::string::npos) << why;
   const Outcome two = run_cli(tight + "--set solver.segments=2 --out '" + (work / "two").string() + "'", work);
   ASSERT_EQ(two.code, 0) << two.out << two.err;
-  EXPECT_NEAR(json::parse(std::ifstream(work / "two" / "report.json"))["final_state"]["theta"].get<double>(), 1.5, 1e-10);
+  const json tr = json::parse(std::ifstream(work / "two" / "report.json"));
+  EXPECT_NEAR(tr["final_state"]["theta"].get<double>(), 1.5, 1e-10);
+
+  // Segments "auto" (one segment at N = 80) doubles them when Newton does not converge: the same
+  // failure with one segment, then the two-segment solve, whose solution it returns.
+  const Outcome aut = run_cli(tight + "--out '" + (work / "auto").string() + "'", work);
+  ASSERT_EQ(aut.code, 0) << aut.out << aut.err;
+  const json ar = json::parse(std::ifstream(work / "auto" / "report.json"));
+  EXPECT_EQ(ar["segments"].get<int>(), 2) << ar.dump();
+  const std::string said = ar["message"];
+  EXPECT_NE(said.find("with 2 segments, counting failed attempts with 1 ("), std::string::npos) << said;
+  EXPECT_NE(ar["detail"].get<std::string>().find("with 1 segment: the residual went only from"), std::string::npos)
+      << ar["detail"];
+  EXPECT_GT(ar["iterations"].get<int>(), tr["iterations"].get<int>());  // the failed attempt's iterations count
+  EXPECT_NEAR(ar["cost"].get<double>(), tr["cost"].get<double>(), 1e-12 * std::abs(tr["cost"].get<double>()));
+  for (const char* key : {"phi", "theta"})
+    EXPECT_NEAR(ar["final_state"][key].get<double>(), tr["final_state"][key].get<double>(), 1e-12) << key;
 }
 
 // Order 8 (quintic, two bubbles, four Gauss points; METHOD.md §9) on both paper examples: the
