@@ -109,6 +109,12 @@ void record_outcome(const ShootingResult<P>& res, RunRecord& r) {
       r.message += (i ? ", " : " ") + std::to_string(res.failed_segment_counts[i]);
     r.message += " (solver.segments \"auto\" doubles the segments when Newton does not converge)";
   }
+  if (!res.ok() && !res.failed_segment_counts.empty()) {  // fewer segments need not be tried again
+    r.message += " (with " + std::to_string(res.segments) + " segments; solver.segments \"auto\" tried";
+    for (size_t i = 0; i < res.failed_segment_counts.size(); ++i)
+      r.message += (i ? ", " : " ") + std::to_string(res.failed_segment_counts[i]);
+    r.message += " first, see the detail)";
+  }
   if (res.ok() && res.propagated_starts)  // the scenes use SegmentStarts::Auto
     r.message += ", counting a failed attempt from the guess's segment starts before the forward sweep's";
   if (res.ok() && !r.continuation_path.empty())

@@ -405,6 +405,25 @@ TEST(ModelProblems, SphericalPendulumFromOneFileSolvesAndConservesItsAngularMome
     EXPECT_NEAR(ar["final_state"][key].get<double>(), tr["final_state"][key].get<double>(), 1e-12) << key;
 }
 
+// When every doubling fails too (the beanie on Galerkin 6 at V = 3000 (1 - cos psi), N = 40, no
+// continuation), the message names the counts tried and the detail keeps each attempt's account.
+TEST(ModelProblems, AutoSegmentsThatAllFailSayWhichCountsWereTried) {
+  const fs::path work = scratch("auto_segments_fail");
+  const Outcome o = run_cli("solve '" + scene("beanie_galerkin") +
+                                "' --set parameters.potential.amplitude=3000 --no-plot --out '" + (work / "out").string() + "'",
+                            work);
+  EXPECT_EQ(o.code, 1) << o.out << o.err;
+  const json r = json::parse(std::ifstream(work / "out" / "report.json"));
+  EXPECT_FALSE(r["converged"].get<bool>());
+  EXPECT_EQ(r["segments"].get<int>(), 4);
+  const std::string said = r["message"];
+  EXPECT_NE(said.find("(with 4 segments; solver.segments \"auto\" tried 1, 2 first, see the detail)"), std::string::npos)
+      << said;
+  const std::string detail = r["detail"];
+  EXPECT_NE(detail.find("earlier attempts with 1 segment: "), std::string::npos) << detail;
+  EXPECT_NE(detail.find("; with 2 segments: "), std::string::npos) << detail;
+}
+
 // Order 8 (quintic, two bubbles, four Gauss points; METHOD.md §9) on both paper examples: the
 // electron against its exact optimum, positions and cost; the beanie (SE(2), constraints at the
 // Gauss points) against a grid four times finer (N = 64: error ~1e-14), θ(T) hit (the discrete
