@@ -15,7 +15,8 @@
 //     (chord_converges) is evaluated without, and takes that step: exact Newton's last
 //     Jacobian costs a sweep with sensitivities (a Galerkin beanie's: ~6x one without).
 //  2. if full steps diverge (the unscaled residual, NonlinearSystem::progress_norm, above 10x
-//     the start's, or F not evaluable) or do not converge: KIN_LINESEARCH from the best iterate.
+//     the start's, or F not evaluable) or do not converge: KIN_LINESEARCH from the best iterate
+//     (stopped when it crawls, if SolverOptions::stop_when_crawling asks).
 // Exceptions never cross the C frames: they are stored and rethrown after KINSol returns.
 #include "band_lu.hpp"
 #include "nonlinear_solver.hpp"
@@ -68,7 +69,20 @@ struct KinsolData {
   // (fresh_jacobian: not itself reused).
   bool chord_planned = false, fresh_jacobian = false;
   bool chord_taken = false;  // the last step was a chord step
+  // Phase 2: where its iterates start in the history, and whether it was stopped for crawling.
+  size_t search_start = 0;
+  bool crawled = false;
 };
+
+// The line search crawls: over its last `crawl_window` iterations the residual's max-norm fell
+// less than 2-fold (SolverOptions::stop_when_crawling).
+constexpr int crawl_window = 5;
+bool crawling(const KinsolData& d) {
+  const std::vector<double>& h = *d.history;
+  const size_t n = h.size();
+  return !d.full_steps && d.options->stop_when_crawling && n >= d.search_start + crawl_window + 1 &&
+         !(h[n - 1] <= 0.5 * h[n - 1 - crawl_window]);
+}
 
 // Whether a full Newton step's next iterate will need the Jacobian: its residual, predicted
 // from quadratic convergence (e_next = C e², C from the last two norms: e_last³ / e_before²),
@@ -225,6 +239,10 @@ int kin_jacobian(N_Vector u, N_Vector, SUNMatrix Jm, void* user, N_Vector, N_Vec
     if (d->record_at_residuals && d->jacobians > 0) return 0;  // recorded at the residuals (a refresh)
     if (++d->jacobians > 1) d->history->push_back(norm);  // the start is recorded before KINSol
     if (d->options->on_iteration) d->options->on_iteration(d->jacobians, norm);
+    if (crawling(*d)) {
+      d->crawled = true;
+      return -1;  // unrecoverable: KINSOL stops, the caller tries its remedy
+    }
     return 0;
   } catch (...) {
     d->error = std::current_exception();
@@ -388,7 +406,11 @@ SolverOutcome solve_kinsol(NonlinearSystem& system, Eigen::VectorXd& x, const So
     x = data.best_x;
     if (out.iterations < opt.max_iterations) {
       phases += "; then line search";
+      data.search_start = out.residual_history.size();
       flag = kinsol_run(data, x, opt, KIN_LINESEARCH, out.iterations);
+      if (data.crawled)
+        phases += ", stopped when it crawled (the residual fell less than 2-fold in " + std::to_string(crawl_window) +
+                  " iterations)";
     }
     phases += ")";
     if (data.best_norm < INFINITY && !converged(x)) x = data.best_x;  // never return worse than seen
@@ -399,8 +421,8 @@ SolverOutcome solve_kinsol(NonlinearSystem& system, Eigen::VectorXd& x, const So
   if (ok && out.residual_norm <= opt.tolerance) {
     out.status = SolverStatus::Converged;
   } else {
-    out.status = flag < 0 ? SolverStatus::Failed : SolverStatus::NotConverged;
-    out.message = "KINSOL stopped with " + flag_name(flag) + " after " + std::to_string(out.iterations) +
+    out.status = flag < 0 && !data.crawled ? SolverStatus::Failed : SolverStatus::NotConverged;
+    out.message = "KINSOL stopped with " + (data.crawled ? std::string("its line search crawling") : flag_name(flag)) + " after " + std::to_string(out.iterations) +
                   " iterations" + phases + ", residual " + format_residual(out.residual_norm);
   }
   return out;

@@ -63,6 +63,11 @@ struct SolverOptions {
   // Jacobian once, and its later full Newton steps, on that factorization, are exact Newton steps.
   bool affine = false;
   LinearSolver linear_solver = LinearSolver::Auto;
+  // The caller has a cheaper remedy than a long line search (shooting: more segments,
+  // ShootingOptions::segment_doublings): KINSOL's line search then stops when it crawls, its
+  // residual falling less than 2-fold over 5 iterations (the spherical pendulum's windows on one
+  // 80-step segment: 2.2e9 to 5.8e8 tolerances in 47 iterations). NLopt ignores it.
+  bool stop_when_crawling = false;
 };
 
 enum class SolverStatus { Converged, NotConverged, Failed };

@@ -30,6 +30,10 @@ enum class SegmentStarts { Guess, Propagated, Auto };
 // segment; the structured linear algebra makes the count's cost linear.
 inline int auto_segments(int steps) { return std::max(1, steps / 100 + (steps % 100 != 0)); }
 
+// How many times "auto" doubles the segments when Newton does not converge
+// (ShootingOptions::segment_doublings): 1, 2 and 4 times the auto count are tried.
+constexpr int auto_segment_doublings = 2;
+
 struct ShootingOptions {
   ShootingMethod method = ShootingMethod::Single;
   int segments = 0;  // multiple shooting; 0: auto_segments(N)
@@ -40,7 +44,8 @@ struct ShootingOptions {
   int threads = 0;               // 0: one per available core
   // When a solve does not converge for a reason more segments address (Newton did not bring the
   // residual down from the guess, or the flow failed from it), solve again with twice the
-  // segments, at most this many times. -1: 2 when segments is auto (0), none for a given count.
+  // segments, at most this many times. -1: auto_segment_doublings when segments is auto (0),
+  // none for a given count.
   int segment_doublings = -1;
   // Called as segments are propagated within one evaluation (segment done, of S): progress for
   // evaluations that take long (large N); may throw to stop the solve.
@@ -286,12 +291,19 @@ ShootingResult<X> solve_bvp_with(const typename SchemeFor<X>::BVP& bvp, const ty
   const int doublings = opt.method == ShootingMethod::Single ? 0
                         : opt.segment_doublings >= 0   ? opt.segment_doublings
                         : opt.segments > 0             ? 0
-                                                       : 2;
-  ShootingResult<X> out = detail::solve_with_segments<X>(bvp, guess, S, opt);
+                                                       : auto_segment_doublings;
+  // An attempt that more segments may follow stops a crawling line search (SolverOptions::
+  // stop_when_crawling): the spherical pendulum's windows on one 80-step segment at 1e-11 cut
+  // the residual 4-fold in 47 line-search iterations before two segments converged in 4.
+  auto attempt = [&](int segments, bool more_follow) {
+    ShootingOptions o = opt;
+    o.solver.stop_when_crawling = opt.solver.stop_when_crawling || more_follow;
+    return detail::solve_with_segments<X>(bvp, guess, segments, o);
+  };
+  ShootingResult<X> out = attempt(S, doublings > 0 && S < most);
   // More segments when Newton did not converge from the guess for a reason they address: it
-  // did not bring the residual down (a long segment amplifies the guess's error; the spherical
-  // pendulum's windows on one 80-step segment at 1e-11 crawl for 49 iterations, two segments
-  // converge in 4), or the flow failed from the guess. Not after a stall at the roundoff floor
+  // did not bring the residual down (a long segment amplifies the guess's error), or the flow
+  // failed from the guess. Not after a stall at the roundoff floor
   // (finer segments do not lower it much, and a large solve would pay twice), nor for a rank
   // deficient Jacobian (the data are dependent).
   auto addressed = [](const ShootingResult<X>& r) {
@@ -302,7 +314,7 @@ ShootingResult<X> solve_bvp_with(const typename SchemeFor<X>::BVP& bvp, const ty
     earlier += (earlier.empty() ? "" : "; ") + std::string("with ") + std::to_string(S) + (S == 1 ? " segment: " : " segments: ") +
                out.message + (out.detail.empty() ? "" : " [" + out.detail + "]");
     S = std::min(most, 2 * S);
-    ShootingResult<X> more = detail::solve_with_segments<X>(bvp, guess, S, opt);
+    ShootingResult<X> more = attempt(S, d + 1 < doublings && S < most);
     more.iterations += out.iterations;
     more.failed_segment_counts = out.failed_segment_counts;
     more.failed_segment_counts.push_back(out.segments);

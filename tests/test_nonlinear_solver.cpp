@@ -1,5 +1,6 @@
 // The solver backends on small systems with known behaviour: a root where full Newton steps
-// diverge (the line-search fallback must take over), a residual with a noise floor above the
+// diverge (the line-search fallback must take over), a line search that crawls (stopped when the
+// caller has a better remedy), a residual with a noise floor above the
 // tolerance (a stall, reported as such), and a root both backends reach from a fair start.
 #include <lpshoot/shooting/nonlinear_solver.hpp>
 
@@ -41,6 +42,20 @@ struct Noisy : NonlinearSystem {
   }
   bool jacobian(const Eigen::VectorXd&, SparseJacobian& J) override {
     J = Eigen::MatrixXd::Identity(2, 2).sparseView();
+    return true;
+  }
+};
+
+// F(x) = x with a Jacobian that claims 100 I: every Newton step cuts the residual by only 1%,
+// and the line search accepts each full step (Armijo holds): it crawls.
+struct Sluggish : NonlinearSystem {
+  int size() const override { return 2; }
+  bool residual(const Eigen::VectorXd& x, Eigen::VectorXd& F) override {
+    F = x;
+    return true;
+  }
+  bool jacobian(const Eigen::VectorXd&, SparseJacobian& J) override {
+    J = Eigen::MatrixXd(100.0 * Eigen::MatrixXd::Identity(2, 2)).sparseView();
     return true;
   }
 };
@@ -137,6 +152,40 @@ TEST(NonlinearSolver, LineSearchTakesOverWhenFullNewtonStepsDiverge) {
   ASSERT_EQ(out.status, SolverStatus::Converged) << out.message;
   EXPECT_LT((x - f.a).lpNorm<Eigen::Infinity>(), 1e-12);
   EXPECT_LE(out.residual_history.back(), 1e-12);
+}
+
+// A crawling line search runs to the iteration limit unless the caller asks to stop it
+// (SolverOptions::stop_when_crawling: shooting with more segments to try). Then it stops once
+// 5 iterations cut the residual less than 2-fold (0.99^5 here), and says so.
+TEST(NonlinearSolver, ACrawlingLineSearchStopsWhenTheCallerAsks) {
+  for (bool stop : {false, true}) {
+    Sluggish f;
+    Eigen::VectorXd x = Eigen::Vector2d(1.0, -2.0);
+    SolverOptions opt;
+    opt.tolerance = 1e-10;
+    opt.stop_when_crawling = stop;
+    const SolverOutcome out = solve_nonlinear(f, x, opt);
+    EXPECT_NE(out.status, SolverStatus::Converged) << out.message;
+    EXPECT_GT(out.residual_norm, 1.0) << out.message;
+    const bool said = out.message.find("stopped when it crawled") != std::string::npos;
+    EXPECT_EQ(said, stop) << out.message;
+    if (stop) {  // 4 full steps that do not halve it, then 5 + 1 line-search iterations at most
+      EXPECT_LE(out.iterations, 11) << out.message;
+      EXPECT_GE(out.iterations, 6) << out.message;
+    } else {
+      EXPECT_EQ(out.iterations, opt.max_iterations) << out.message;
+    }
+  }
+  // A line search that makes progress is not stopped (atan from a distance where full steps diverge).
+  Atan f;
+  f.a = Eigen::Vector2d(0.5, -1.0);
+  Eigen::VectorXd x = f.a + Eigen::Vector2d(2.0, -2.5);
+  SolverOptions opt;
+  opt.tolerance = 1e-12;
+  opt.stop_when_crawling = true;
+  const SolverOutcome out = solve_nonlinear(f, x, opt);
+  ASSERT_EQ(out.status, SolverStatus::Converged) << out.message;
+  EXPECT_LT((x - f.a).lpNorm<Eigen::Infinity>(), 1e-12);
 }
 
 TEST(NonlinearSolver, FullNewtonStepsConvergeQuadraticallyFromAFairStart) {

@@ -103,17 +103,13 @@ void record_outcome(const ShootingResult<P>& res, RunRecord& r) {
   r.message = res.ok() ? "converged in " + std::to_string(res.iterations) + " iterations" : res.message;
   r.detail = res.detail;
   if (res.segments > 0) r.segments = res.segments;  // "auto" may have doubled the scene's count
-  if (res.ok() && !res.failed_segment_counts.empty()) {
-    r.message += " with " + std::to_string(res.segments) + " segments, counting failed attempts with";
-    for (size_t i = 0; i < res.failed_segment_counts.size(); ++i)
-      r.message += (i ? ", " : " ") + std::to_string(res.failed_segment_counts[i]);
-    r.message += " (solver.segments \"auto\" doubles the segments when Newton does not converge)";
-  }
-  if (!res.ok() && !res.failed_segment_counts.empty()) {  // fewer segments need not be tried again
-    r.message += " (with " + std::to_string(res.segments) + " segments; solver.segments \"auto\" tried";
-    for (size_t i = 0; i < res.failed_segment_counts.size(); ++i)
-      r.message += (i ? ", " : " ") + std::to_string(res.failed_segment_counts[i]);
-    r.message += " first, see the detail)";
+  if (!res.failed_segment_counts.empty()) {  // named also on failure: fewer need not be tried again
+    std::string counts;
+    for (int c : res.failed_segment_counts) counts += (counts.empty() ? "" : ", ") + std::to_string(c);
+    const std::string S = std::to_string(res.segments);
+    r.message += res.ok() ? " with " + S + " segments, counting failed attempts with " + counts +
+                                " (solver.segments \"auto\" doubles the segments when Newton does not converge)"
+                          : " (with " + S + " segments; solver.segments \"auto\" tried " + counts + " first, see the detail)";
   }
   if (res.ok() && res.propagated_starts)  // the scenes use SegmentStarts::Auto
     r.message += ", counting a failed attempt from the guess's segment starts before the forward sweep's";

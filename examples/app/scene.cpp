@@ -371,7 +371,7 @@ void read_solver(const Reader& r, Scene& s) {
   if (s.shooting.method == ShootingMethod::Single) s.shooting.segments = 1;  // segments: multiple shooting only
   // "auto" also doubles the segments, twice at most, when Newton does not converge (shooting.hpp);
   // a count the scene gives is kept.
-  s.shooting.segment_doublings = s.auto_segments ? 2 : 0;
+  s.shooting.segment_doublings = s.auto_segments ? auto_segment_doublings : 0;
   s.shooting.solver.backend = r.choice("backend", {"kinsol", "nlopt"}, "kinsol") == "nlopt" ? Backend::Nlopt : Backend::Kinsol;
   s.shooting.solver.tolerance = r.positive("tolerance", 1e-10);
   if (s.shooting.solver.tolerance < 1e-14 || s.shooting.solver.tolerance > 1)

@@ -96,7 +96,7 @@ SweepRecord run_sweep(const Scene& scene, const std::string& command, const Swee
           }
           else if (scene.auto_segments || scene.shooting.method == ShootingMethod::Single) {
             segments = s.default_segments(N);  // per grid (a single-shooting scene: multiple shooting's default)
-            s.shooting.segment_doublings = 2;  // as "auto" does (scene.cpp)
+            s.shooting.segment_doublings = auto_segment_doublings;  // as "auto" does (scene.cpp)
           }
           s.shooting.segments = std::clamp(segments, 1, s.max_segments(N));
           sr.scheme = s.scheme_name();

@@ -374,7 +374,7 @@ TEST(ModelProblems, SphericalPendulumFromOneFileSolvesAndConservesItsAngularMome
 
   // One segment of 80 steps at tolerance 1e-11: the first full Newton step from the boundary
   // curve raises the residual and the line search crawls (5.8e8 x tolerance after 49
-  // iterations), far above the scheme's roundoff floor (1.6e4 x tolerance). The message says so
+  // iterations, when no more segments are to be tried), far above the scheme's roundoff floor (1.6e4 x tolerance). The message says so
   // and names the remedy, which works: two segments converge in 4 iterations.
   const std::string tight = "solve '" + scene("spherical_pendulum") +
                             "' --set 'scheme={\"discretization\": \"paper\"}' --set horizon.N=80 --set solver.tolerance=1e-11 --no-plot ";
@@ -400,6 +400,12 @@ TEST(ModelProblems, SphericalPendulumFromOneFileSolvesAndConservesItsAngularMome
   EXPECT_NE(ar["detail"].get<std::string>().find("with 1 segment: the residual went only from"), std::string::npos)
       << ar["detail"];
   EXPECT_GT(ar["iterations"].get<int>(), tr["iterations"].get<int>());  // the failed attempt's iterations count
+  // With more segments to try, the one-segment attempt's line search stops once it crawls (less
+  // than a 2-fold cut in 5 iterations): both attempts take fewer iterations than the explicit
+  // one-segment run, which has no remedy left and crawls on.
+  EXPECT_NE(ar["detail"].get<std::string>().find("stopped when it crawled"), std::string::npos) << ar["detail"];
+  EXPECT_EQ(fr.value("detail", std::string()).find("stopped when it crawled"), std::string::npos) << fr["detail"];
+  EXPECT_LT(ar["iterations"].get<int>(), fr["iterations"].get<int>()) << ar["iterations"] << " " << fr["iterations"];
   EXPECT_NEAR(ar["cost"].get<double>(), tr["cost"].get<double>(), 1e-12 * std::abs(tr["cost"].get<double>()));
   for (const char* key : {"phi", "theta"})
     EXPECT_NEAR(ar["final_state"][key].get<double>(), tr["final_state"][key].get<double>(), 1e-12) << key;
