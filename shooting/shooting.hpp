@@ -197,9 +197,13 @@ ShootingResult<X> solve_from_starts(const typename SchemeFor<X>::BVP& bvp,
   }
   if (so.status != SolverStatus::Converged) {
     std::string msg;
-    if (so.residual_history.empty() || !std::isfinite(out.residual_norm)) {
+    if (so.residual_history.empty()) {
       msg = "the shooting residual is not finite at the guess (the flow overflows from it): try multiple shooting with "
             "more segments, a smaller h, or a better guess";
+    } else if (!std::isfinite(out.residual_norm)) {
+      msg = "the shooting residual is not finite at the solver's last iterate (the flow overflows there), from " +
+            format_residual(so.residual_history.front()) +
+            " x tolerance at the guess: try multiple shooting with more segments, a smaller h, or a better guess";
     } else if (diverged) {
       msg = "the residual grew from " + format_residual(so.residual_history.front()) + " at the guess to " +
             format_residual(out.residual_norm) + " x tolerance" + rank_note +

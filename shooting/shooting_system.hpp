@@ -293,7 +293,11 @@ class ShootingSystem : public NonlinearSystem {
   // kept: the solver asks again for what the setup (row tolerances) already computed at the guess.
   bool evaluate(const Eigen::VectorXd& x, Eigen::VectorXd& F, SparseJacobian* J) {
     const bool same_x = memo_x_.size() == x.size() && memo_x_ == x;
-    if (same_x && (!J || memo_has_J_)) {
+    // A failure is reused only for the same kind of request: a sweep with sensitivities that
+    // failed says nothing about one without (their steps solve differently: chord matrices,
+    // guides). The beanie on Galerkin 6 at V = 3000 (1 - cos psi), one segment: the Jacobian at
+    // the best iterate failed, and the residual there was then taken as not finite.
+    if (same_x && (memo_ok_ ? !J || memo_has_J_ : memo_has_J_ == (J != nullptr))) {
       if (!memo_ok_) return false;
       F = memo_F_;
       if (J) *J = last_J_;

@@ -428,6 +428,11 @@ TEST(ModelProblems, AutoSegmentsThatAllFailSayWhichCountsWereTried) {
   const std::string detail = r["detail"];
   EXPECT_NE(detail.find("earlier attempts with 1 segment: "), std::string::npos) << detail;
   EXPECT_NE(detail.find("; with 2 segments: "), std::string::npos) << detail;
+  // The one-segment attempt's residual was finite at the guess (1.6e11 tolerances) and at its
+  // best iterate: a sweep with sensitivities that failed there does not make the residual there
+  // "not finite" (ShootingSystem::evaluate reuses a failure only for the same kind of request).
+  EXPECT_EQ(detail.find("not finite"), std::string::npos) << detail;
+  EXPECT_NE(detail.find("earlier attempts with 1 segment: the residual went only from"), std::string::npos) << detail;
 }
 
 // Order 8 (quintic, two bubbles, four Gauss points; METHOD.md §9) on both paper examples: the
