@@ -111,6 +111,37 @@ TEST(NewtonChord, AMatrixWhoseChordStepsDoNotContractIsRefreshed) {
   EXPECT_LT((carried - sys.J(s.z)).lpNorm<Eigen::Infinity>(), 0.02 * (sys.J(far) - sys.J(s.z)).lpNorm<Eigen::Infinity>());
 }
 
+// A carried matrix whose chord steps contract, but slowly: M = A / 0.76 on the affine F = A z - b
+// gives dz = -0.76 (z - z*), so every chord correction is 0.24 times the last. From a correction of
+// ~760 the step tolerance (1e-12 (1 + |z_i|), |z_i| >= 700) is 20 chord steps away: one too many
+// for 20 iterations. At the rate measured after the second step the chord cannot make it, so the
+// matrix is refreshed there, and Newton on the affine equations converges in two more.
+TEST(NewtonChord, AChordTooSlowForTheIterationsLeftIsRefreshed) {
+  CubicSystem sys = base_system();
+  sys.c = 0;
+  const V3 solution(1000, -700, 900);
+  sys.b = sys.A * solution;
+  ChordMatrix<3> chord;
+  chord.lu.compute(M3(sys.A / 0.76));
+  chord.condition = condition_number_1(M3(sys.A / 0.76), chord.lu);
+  chord.valid = true;
+  const Solve s = solve(sys, V3::Zero(), &chord);
+  ASSERT_EQ(s.report.status, StepStatus::Converged) << s.report.message;
+  EXPECT_EQ(s.jacobians, 1);
+  EXPECT_LE(s.report.iterations, 5);
+  EXPECT_LT((s.z - solution).lpNorm<Eigen::Infinity>(), 1e-12 * 1000);
+  // The same chord with iterations to spare (30) is left to converge on its own, at 0.24 a step.
+  NewtonOptions patient;
+  patient.max_iterations = 30;
+  chord.lu.compute(M3(sys.A / 0.76));
+  chord.condition = condition_number_1(M3(sys.A / 0.76), chord.lu);
+  chord.valid = true;
+  const Solve p = solve(sys, V3::Zero(), &chord, patient);
+  ASSERT_EQ(p.report.status, StepStatus::Converged) << p.report.message;
+  EXPECT_EQ(p.jacobians, 0);
+  EXPECT_GE(p.report.iterations, 20);
+}
+
 TEST(NewtonChord, ASingularMatrixIsReportedAndNotCarried) {
   CubicSystem sys = base_system();
   sys.A.setZero();  // J(0) = 0
