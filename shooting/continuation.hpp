@@ -85,7 +85,8 @@ struct ContinuationResult {
 };
 
 // Solves make(s) for s from `from` to `to`, each solve starting from the previous solution; a
-// failed step is halved, a success lets the step grow by 1.5.
+// failed step is halved (the step tried: the last one is cut short to end at `to`), a success
+// lets the step grow by 1.5.
 template <class P>
 ContinuationResult<P> continuation(const std::function<typename SchemeFor<P>::BVP(double)>& make, double from, double to,
                                    const typename SchemeFor<P>::Guess& guess, const ShootingOptions& opt = {},
@@ -107,13 +108,14 @@ ContinuationResult<P> continuation(const std::function<typename SchemeFor<P>::BV
     auto r = solve_bvp(make(next), as_guess(out.result), opt);
     ++out.solves;
     if (copt.on_solve) copt.on_solve(next, r.ok(), r.iterations);
+    const double tried = next - out.parameter;  // the step, or what was left of the way to `to`
     if (r.ok()) {
       out.result = std::move(r);
       out.parameter = next;
       out.path.push_back(next);
       step *= 1.5;
     } else {
-      step *= 0.5;
+      step = 0.5 * tried;  // not the uncut step: halved, it could reach `to` again
       if (std::abs(step) < copt.min_step * std::abs(span)) {
         out.result.status = r.status;
         out.result.message = "continuation stalled at " + std::to_string(out.parameter) + " (step below " +

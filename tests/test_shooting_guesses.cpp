@@ -73,6 +73,39 @@ TEST(ShootingGuesses, ContinuationInThePotentialScaleReachesTheTarget) {
   EXPECT_LE(again.iterations, 2);
 }
 
+// A failed step is halved from the step it tried, also when that one was cut short to reach the
+// target: the electron whose potential is not finite above 0.9 (every solve there fails), from 0
+// to 1 with a first step of 0.75. 1 fails after 0.75; halving the uncut step (1.125) would try 1
+// again, twice. Each failed value is tried once, and the continuation closes in on 0.9.
+TEST(ShootingGuesses, ContinuationHalvesTheStepItTriedAtTheTarget) {
+  const ElectronBoundary start{Eigen::Vector3d(1.0, 0.0, 0.5), Eigen::Vector3d(0.0, 1.0, 0.0)};
+  const ElectronBoundary end{Eigen::Vector3d(0.0, 1.0, -0.5), Eigen::Vector3d(-1.0, 0.0, 0.2)};
+  auto make = [&](double s) {
+    Electron e;
+    e.potential = s <= 0.9 ? s : std::nan("");
+    return electron_bvp(e, 2.0, 50, start, end, Closure::SecondOrder);
+  };
+  std::vector<std::pair<double, bool>> tried;
+  ContinuationOptions copt;
+  copt.initial_step = 0.75;
+  copt.on_solve = [&](double s, bool ok, int) { tried.emplace_back(s, ok); };
+  ShootingOptions opt;
+  opt.method = ShootingMethod::Multiple;
+  opt.segments = 2;
+  const auto cont = continuation<Electron>(make, 0.0, 1.0, electron_guess(make(0.0), start, end), opt, copt);
+  EXPECT_FALSE(cont.reached);
+  ASSERT_GE(tried.size(), 4u);
+  EXPECT_EQ(tried[1].first, 0.75);
+  EXPECT_EQ(tried[2].first, 1.0);
+  EXPECT_FALSE(tried[2].second);
+  EXPECT_EQ(tried[3].first, 0.875);  // 0.75 + (1 - 0.75) / 2
+  for (size_t i = 1; i < tried.size(); ++i)
+    EXPECT_FALSE(!tried[i - 1].second && tried[i].first == tried[i - 1].first) << "value " << tried[i].first << " tried twice";
+  // Stalled with a step below min_step (1e-4): the last failure was within 2e-4 above the last success.
+  EXPECT_LE(cont.parameter, 0.9);
+  EXPECT_GT(cont.parameter, 0.9 - 2e-4);
+}
+
 namespace {
 // The interval data of the curve p(t) = Σ_k c_k t^k (degree ≤ 5) on [t, t + h], by Taylor:
 // X2 = Σ_{k≥2} p^(k) h^(k-2)/k!, V1 = Σ_{k≥2} p^(k) h^(k-2)/(k-1)!; the bubbles from the curve's
