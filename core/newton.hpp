@@ -257,7 +257,7 @@ StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian,
     // V = 3000 (1 − cos ψ), a step from the guess: chord steps at ρ ≈ 0.22 for 20 iterations,
     // from a first correction of 755 down to 4e-12, and the flow failed.
     auto too_slow = [&] {
-      const double rho = size / last_step;  // 0 after the first iteration
+      const double rho = size / last_step;  // 0 on the first iteration (no last step yet)
       const double excess = (dz.cwiseAbs().array() / (opt.step_tolerance * (1.0 + scale.array()))).maxCoeff();
       return rho > 0 && excess > 1 && std::log(excess) > (opt.max_iterations - it) * std::log(1 / rho);
     };
