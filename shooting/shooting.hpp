@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <limits>
 
 namespace lpshoot {
 
@@ -63,9 +64,12 @@ struct ShootingResult {
   std::string detail;   // the solver's own account (flags, phases), the other attempt's outcome
   int iterations = 0;
   std::vector<double> residual_history;
-  double residual_norm = 0;
-  double condition = 0;  // 1-norm condition estimate of the equilibrated shooting Jacobian at the solution
-  double raw_residual_norm = 0;  // max-norm of the conditions in their own units
+  // NaN below: not evaluated (a flow that failed from the guess leaves no residual, Jacobian or
+  // trajectory; 0 would read as a perfect solve). Infinity: evaluated and overflowed.
+  double residual_norm = std::numeric_limits<double>::quiet_NaN();
+  // 1-norm condition estimate of the equilibrated shooting Jacobian at the solution
+  double condition = std::numeric_limits<double>::quiet_NaN();
+  double raw_residual_norm = std::numeric_limits<double>::quiet_NaN();  // max-norm of the conditions in their own units
   // residual_norm: max over rows of |F_i| / tolerance_i (<= 1 at convergence); tolerance_i is the
   // solver tolerance plus the row's roundoff floor (see row_tolerances).
   int rank = -1, unknowns = 0;  // rank -1: not computed (the flow failed or overflowed there)
@@ -74,7 +78,7 @@ struct ShootingResult {
   double wall_time_s = 0;
   typename A::Trajectory trajectory;
   std::vector<typename A::GroupElem> g;    // g_0 .. g_N
-  double cost = 0;                         // the discrete cost (Σ L_d without multiplier terms)
+  double cost = std::numeric_limits<double>::quiet_NaN();  // the discrete cost (Σ L_d without multiplier terms)
   double momentum_drift = 0;               // relative max |J_n - J_first| of the discrete momentum map
   bool propagated_starts = false;          // multiple shooting started from the forward sweep
   bool stalled_at_floor = false;           // not converged: stalled at the flows' roundoff floor

@@ -106,6 +106,27 @@ TEST(ShootingGuesses, ContinuationHalvesTheStepItTriedAtTheTarget) {
   EXPECT_GT(cont.parameter, 0.9 - 2e-4);
 }
 
+// A flow that fails from the guess leaves nothing evaluated: the result says so with NaN (not 0,
+// which reads as a perfect solve), and no rank.
+TEST(ShootingGuesses, AFlowThatFailsFromTheGuessReportsNothingAsEvaluated) {
+  const ElectronBoundary start{Eigen::Vector3d(1.0, 0.0, 0.5), Eigen::Vector3d(0.0, 1.0, 0.0)};
+  const ElectronBoundary end{Eigen::Vector3d(0.0, 1.0, -0.5), Eigen::Vector3d(-1.0, 0.0, 0.2)};
+  Electron e;
+  e.potential = std::nan("");
+  const auto bvp = electron_bvp(e, 2.0, 50, start, end, Closure::SecondOrder);
+  ShootingOptions opt;
+  opt.method = ShootingMethod::Multiple;
+  opt.segments = 2;
+  const auto r = solve_bvp(bvp, electron_guess(bvp, start, end), opt);
+  ASSERT_EQ(r.status, ShootingStatus::FlowFailed) << r.message;
+  EXPECT_NE(r.message.find("from the initial guess"), std::string::npos) << r.message;
+  EXPECT_TRUE(std::isnan(r.residual_norm)) << r.residual_norm;
+  EXPECT_TRUE(std::isnan(r.raw_residual_norm)) << r.raw_residual_norm;
+  EXPECT_TRUE(std::isnan(r.condition)) << r.condition;
+  EXPECT_TRUE(std::isnan(r.cost)) << r.cost;
+  EXPECT_EQ(r.rank, -1);
+}
+
 namespace {
 // The interval data of the curve p(t) = Σ_k c_k t^k (degree ≤ 5) on [t, t + h], by Taylor:
 // X2 = Σ_{k≥2} p^(k) h^(k-2)/k!, V1 = Σ_{k≥2} p^(k) h^(k-2)/(k-1)!; the bubbles from the curve's

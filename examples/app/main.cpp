@@ -103,11 +103,16 @@ void print_run(const RunRecord& r) {
     if (!r.constraints.empty()) std::printf(", constraints %s", r.constraints.c_str());
   }
   std::printf("\nstatus: %s (%s)\n", r.status.c_str(), r.message.c_str());
+  // NaN: not evaluated (the flow failed before the solver ran); "0" would read as a perfect solve.
+  auto measured = [](double x, const char* none) { return std::isnan(x) ? std::string(none) : fmt("%.3g", x); };
   if (r.command == "solve")
-    std::printf("residual: %s x tolerance (raw %s), Jacobian condition %s, rank %s of %d\n",
-                fmt("%.3g", r.residual_norm).c_str(), fmt("%.3g", r.raw_residual_norm).c_str(),
-                fmt("%.3g", r.condition).c_str(), r.rank >= 0 ? std::to_string(r.rank).c_str() : "not computed",
-                r.unknowns);
+    std::printf("residual: %s, Jacobian condition %s, rank %s of %d\n",
+                std::isnan(r.residual_norm) ? "not evaluated"
+                                            : (fmt("%.3g", r.residual_norm) + " x tolerance (raw " +
+                                               measured(r.raw_residual_norm, "not evaluated") + ")")
+                                                  .c_str(),
+                measured(r.condition, "not computed").c_str(),
+                r.rank >= 0 ? std::to_string(r.rank).c_str() : "not computed", r.unknowns);
   else
     std::printf("Newton: %d iterations over all steps, max step residual %s, max step condition %s\n", r.iterations,
                 fmt("%.3g", r.residual_norm).c_str(), fmt("%.3g", r.condition).c_str());

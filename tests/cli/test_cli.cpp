@@ -433,6 +433,15 @@ TEST(ModelProblems, AutoSegmentsThatAllFailSayWhichCountsWereTried) {
   // "not finite" (ShootingSystem::evaluate reuses a failure only for the same kind of request).
   EXPECT_EQ(detail.find("not finite"), std::string::npos) << detail;
   EXPECT_NE(detail.find("earlier attempts with 1 segment: the residual went only from"), std::string::npos) << detail;
+  // The last attempt's flow failed from the guess: no residual, Jacobian or cost was evaluated,
+  // and none is reported as a number (it said "residual: 0 x tolerance (raw 0), Jacobian
+  // condition 0", which reads as a perfect solve).
+  EXPECT_EQ(r["status"], "flow_failed");
+  for (const char* key : {"residual_norm", "raw_residual_norm", "condition", "cost", "action"})
+    EXPECT_TRUE(r[key].is_null()) << key << " = " << r[key];
+  EXPECT_NE(o.out.find("residual: not evaluated, Jacobian condition not computed, rank not computed of 116"),
+            std::string::npos)
+      << o.out;
 }
 
 // Order 8 (quintic, two bubbles, four Gauss points; METHOD.md §9) on both paper examples: the
