@@ -22,6 +22,10 @@ struct Trajectory {
   std::vector<Vec<double, P::shape_dim>> p;            // p_0 .. p_N
   std::vector<GroupElement<P, double>> g;              // g~_0 .. g~_{N-1}
   std::vector<Vec<double, P::num_constraints>> lam;    // λ^0 .. λ^{N-k}
+  // Low parts of p (compensated.hpp), one per node when the flow kept them (problems with
+  // keeps_low_parts), else empty: read as zero. Whoever edits p drops them (clear()).
+  std::vector<Vec<double, P::shape_dim>> p_low;
+  bool has_low_parts() const { return !p_low.empty() && p_low.size() == p.size(); }
   int N() const { return static_cast<int>(p.size()) - 1; }
   double time(int n) const { return n * h; }
 
@@ -29,6 +33,8 @@ struct Trajectory {
   Window<P, double> window_at(int j) const {
     Window<P, double> a;
     for (int i = 0; i <= P::order; ++i) a.p[i] = p[j + i];
+    if (has_low_parts())
+      for (int i = 0; i <= P::order; ++i) a.p_low[i] = p_low[j + i];
     for (int i = 0; i < P::order; ++i) a.g[i] = g[j + i];
     return a;
   }
@@ -38,6 +44,8 @@ struct Trajectory {
     constexpr int k = P::order;
     FlowState<P> s;
     for (int i = 0; i < 2 * k; ++i) s.p[i] = p[n - k + i];
+    if (has_low_parts())
+      for (int i = 0; i < 2 * k; ++i) s.p_low[i] = p_low[n - k + i];
     for (int i = 0; i < 2 * k - 1; ++i) s.g[i] = g[n - k + i];
     for (int j = 0; j < k; ++j) s.lam[j] = lam[n - k + j];
     return s;
@@ -126,6 +134,10 @@ class DiscreteFlow {
     tr.p.assign(initial.p.begin(), initial.p.end());
     tr.g.assign(initial.g.begin(), initial.g.end());
     tr.lam.assign(initial.lam.begin(), initial.lam.end());
+    if constexpr (keeps_low_parts<P>()) {
+      tr.p_low.assign(initial.p_low.begin(), initial.p_low.end());
+      tr.p_low.reserve(N + 1);
+    }
     tr.p.reserve(N + 1);
     tr.g.reserve(N);
     tr.lam.reserve(N - k + 1);
@@ -185,6 +197,9 @@ class DiscreteFlow {
       // Shift the state and store the new unknowns.
       for (int i = 0; i + 1 < 2 * k; ++i) s.p[i] = s.p[i + 1];
       s.p[2 * k - 1] = z.p;
+      for (int i = 0; i + 1 < 2 * k; ++i) s.p_low[i] = s.p_low[i + 1];
+      s.p_low[2 * k - 1] = z.p_low;
+      if constexpr (keeps_low_parts<P>()) tr.p_low.push_back(z.p_low);
       for (int i = 0; i + 1 < 2 * k - 1; ++i) s.g[i] = s.g[i + 1];
       s.g[2 * k - 2] = z.g;
       for (int j = 0; j + 1 < k; ++j) s.lam[j] = s.lam[j + 1];
@@ -210,7 +225,12 @@ FlowState<P> retract(const FlowState<P>& s, const Vec<double, Dims<P>::state>& d
   using FS = FlowState<P>;
   constexpr int k = P::order, r = P::shape_dim, d = G::dim, m = P::num_constraints;
   FlowState<P> out = s;
-  for (int i = 0; i < 2 * k; ++i) out.p[i] += delta.template segment<r>(FS::p_offset(i));
+  for (int i = 0; i < 2 * k; ++i) {
+    if constexpr (keeps_low_parts<P>())
+      add_compensated(out.p[i], out.p_low[i], Vec<double, r>(delta.template segment<r>(FS::p_offset(i))));
+    else
+      out.p[i] += delta.template segment<r>(FS::p_offset(i));
+  }
   for (int i = 0; i < 2 * k - 1; ++i) {
     const typename G::template Tangent<double> xi = delta.template segment<d>(FS::g_offset(i));
     out.g[i] = G::compose(out.g[i], G::template exp<double>(xi));
@@ -226,7 +246,7 @@ Vec<double, Dims<P>::state> state_difference(const FlowState<P>& a, const FlowSt
   using FS = FlowState<P>;
   constexpr int k = P::order, r = P::shape_dim, d = G::dim, m = P::num_constraints;
   Vec<double, Dims<P>::state> delta;
-  for (int i = 0; i < 2 * k; ++i) delta.template segment<r>(FS::p_offset(i)) = a.p[i] - b.p[i];
+  for (int i = 0; i < 2 * k; ++i) delta.template segment<r>(FS::p_offset(i)) = (a.p[i] - b.p[i]) + (a.p_low[i] - b.p_low[i]);
   for (int i = 0; i < 2 * k - 1; ++i)
     delta.template segment<d>(FS::g_offset(i)) = G::log(G::compose(G::inverse(b.g[i]), a.g[i]));
   for (int j = 0; j < k; ++j) delta.template segment<m>(FS::lam_offset(j)) = a.lam[j] - b.lam[j];

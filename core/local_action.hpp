@@ -22,10 +22,11 @@ struct NodeBlock {
   std::array<Vec<T, P::shape_dim>, 2 * k + 1> p;
   std::array<GroupElement<P, T>, 2 * k> g;
   std::array<Vec<T, P::num_constraints>, k + 1> lam;
+  std::array<Vec<double, P::shape_dim>, 2 * k + 1> p_low = zero_nodes<P::shape_dim, 2 * k + 1>();  // problem.hpp's Window
 
   Window<P, T> window(int j) const {
     Window<P, T> a;
-    for (int i = 0; i <= k; ++i) a.p[i] = p[j + i];
+    for (int i = 0; i <= k; ++i) a.p[i] = p[j + i], a.p_low[i] = p_low[j + i];
     for (int i = 0; i < k; ++i) a.g[i] = g[j + i];
     return a;
   }
@@ -38,6 +39,7 @@ NodeBlock<P, TO> lift(const NodeBlock<P, TI>& b) {
   for (size_t i = 0; i < b.p.size(); ++i) out.p[i] = b.p[i].template cast<TO>();
   for (size_t i = 0; i < b.g.size(); ++i) out.g[i] = P::Group::template cast<TO>(b.g[i]);
   for (size_t i = 0; i < b.lam.size(); ++i) out.lam[i] = b.lam[i].template cast<TO>();
+  out.p_low = b.p_low;
   return out;
 }
 

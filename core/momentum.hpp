@@ -31,6 +31,8 @@ Vec<double, P::Group::dim> body_momentum(const P& problem, const Trajectory<P>& 
   NodeBlock<P, double> b;
   const int o = n - k + 1;  // first window containing g~_n
   for (int i = 0; i <= 2 * k; ++i) b.p[i] = tr.p[std::min(o + i, tr.N())];
+  if (tr.has_low_parts())
+    for (int i = 0; i <= 2 * k; ++i) b.p_low[i] = tr.p_low[std::min(o + i, tr.N())];
   for (int i = 0; i < 2 * k; ++i) b.g[i] = tr.g[std::min<size_t>(o + i, tr.g.size() - 1)];
   for (int j = 0; j <= k; ++j) b.lam[j] = tr.lam[std::min<size_t>(o + j, tr.lam.size() - 1)];
   return right_trivialized_gradient(problem, b, k - 1, 0, k - 1, tr.h);

@@ -17,8 +17,11 @@
 //     q_n = (p_{n+1}, (p_{n+2} − p_n)/(2h), Δ²p_n/h², (ω_n + ω_{n+1})/2, (ω_{n+1} − ω_n)/h);
 //     with ℓ = ½ u(p, p'') this is the paper's beanie L^_d (79), and constraints linear in Ω'
 //     become trapezoidal.
-// Both keep the nodal state (the roundoff of nearly equal nodes, METHOD.md §9); the Galerkin
-// schemes do not have it.
+// The flow keeps the nodes to twice the working precision (keeps_low_parts, compensated.hpp)
+// and the jet takes its differences from both parts (Window::low_difference): Δp and Δ²p are
+// formed to their own precision, never from nodes rounded to doubles, so the recursion does not
+// amplify the nodes' rounding (METHOD.md §9; bench/RESULTS.md, "The paper's windows without
+// their roundoff floor").
 #pragma once
 
 #include "continuous.hpp"
@@ -28,7 +31,8 @@ namespace lpshoot {
 
 enum class WindowJet { Forward, Central };
 
-template <class C, WindowJet J = WindowJet::Central>
+// Low = false: the nodes are rounded to doubles as in a hand-written L_d (for comparison only).
+template <class C, WindowJet J = WindowJet::Central, bool Low = true>
 struct PaperWindows {
   using Model = C;
   using Group = typename C::Group;
@@ -36,14 +40,18 @@ struct PaperWindows {
   static constexpr int order = 2;
   static constexpr int num_constraints = C::num_constraints;
   static constexpr WindowJet jet_kind = J;
+  static constexpr bool keeps_low_parts = Low;
   C model;
 
   // q_n of the file comment.
   template <class T>
   Jet<C, T> jet(const Window<PaperWindows, T>& a, double h) const {
     Jet<C, T> q;
-    const Vec<T, shape_dim> d0 = a.p[1] - a.p[0], d1 = a.p[2] - a.p[1];
-    q.ddp = (d1 - d0) / (h * h);
+    const Vec<T, shape_dim> d0 = a.low_difference(1, 0), d1 = a.low_difference(2, 1);
+    // Δ²p from the nodes' exact differences: (p2 - p1) - (p1 - p0) rounds once, relative to Δ²p.
+    const Vec<T, shape_dim> dd = ((a.p[2] - a.p[1]) - (a.p[1] - a.p[0])) +
+                                 (a.p_low[2] - 2.0 * a.p_low[1] + a.p_low[0]).template cast<T>();
+    q.ddp = dd / (h * h);
     if constexpr (J == WindowJet::Forward) {
       q.p = a.p[0];
       q.dp = d0 / h;
@@ -52,7 +60,8 @@ struct PaperWindows {
       q.dp = (d0 + d1) / (2.0 * h);
     }
     if constexpr (Group::dim > 0) {
-      const Vec<T, Group::dim> w0 = reduced_velocity(a.p[0], a.p[1], a.g[0], h), w1 = reduced_velocity(a.p[1], a.p[2], a.g[1], h);
+      const Vec<T, Group::dim> w0 = reduced_velocity(a.p[0], a.p[1], d0, a.g[0], h),
+                               w1 = reduced_velocity(a.p[1], a.p[2], d1, a.g[1], h);
       if constexpr (J == WindowJet::Forward)
         q.Omega = w0;
       else
@@ -62,15 +71,16 @@ struct PaperWindows {
     return q;
   }
 
-  // ω_j of the file comment, from increment g~ = W A(p0, p1) over [p0, p1].
+  // ω_j of the file comment, from increment g~ = W A(p0, p1) over [p0, p1], dp = p1 - p0.
   template <class T>
-  Vec<T, Group::dim> reduced_velocity(const Vec<T, shape_dim>& p0, const Vec<T, shape_dim>& p1,
+  Vec<T, Group::dim> reduced_velocity(const Vec<T, shape_dim>& p0, const Vec<T, shape_dim>& p1, const Vec<T, shape_dim>& dp,
                                       const typename Group::template Element<T>& g, double h) const {
     if constexpr (detail::HasConnectionForm<C, T>::value) {
-      const Vec<T, Group::dim> a = connection_velocity(model, Vec<T, shape_dim>(0.5 * (p0 + p1)), Vec<T, shape_dim>(p1 - p0));
+      const Vec<T, Group::dim> a = connection_velocity(model, Vec<T, shape_dim>(0.5 * (p0 + p1)), dp);
       const auto W = Group::compose(g, Group::inverse(Group::template exp<T>(a)));
       return (Group::log(W) + a) / h;
     } else {
+      (void)p0, (void)p1, (void)dp;
       return Group::log(g) / h;
     }
   }
@@ -124,9 +134,10 @@ struct PaperWindows {
   T half_window(const Window<PaperWindows, T>& a, const Slopes<S>& s, bool initial, double h) const {
     const int e = initial ? 0 : 2, lo = initial ? 0 : 1;
     T K = T(0.0);
-    for (int i = 0; i < shape_dim; ++i) K = K + T(s.p(i)) * a.p[e](i) + T(s.dp(i)) * (a.p[lo + 1](i) - a.p[lo](i)) / h;
+    const Vec<T, shape_dim> dp = a.low_difference(lo + 1, lo);
+    for (int i = 0; i < shape_dim; ++i) K = K + T(s.p(i)) * a.p[e](i) + T(s.dp(i)) * dp(i) / h;
     if constexpr (Group::dim > 0) {
-      const Vec<T, Group::dim> w = reduced_velocity(a.p[lo], a.p[lo + 1], a.g[lo], h);
+      const Vec<T, Group::dim> w = reduced_velocity(a.p[lo], a.p[lo + 1], dp, a.g[lo], h);
       for (int i = 0; i < Group::dim; ++i) K = K + T(s.Omega(i)) * w(i);
     }
     return 0.5 * K;

@@ -19,6 +19,7 @@
 // with T arithmetic only (use value(x) for branches).
 #pragma once
 
+#include "compensated.hpp"
 #include "dual.hpp"
 #include "groups.hpp"
 
@@ -56,6 +57,14 @@ template <class P, class T>
 struct Window {
   std::array<Vec<T, P::shape_dim>, P::order + 1> p;
   std::array<GroupElement<P, T>, P::order> g;
+  // The nodes' low parts (compensated.hpp): node i is p[i] + p_low[i]. Zero unless the problem
+  // keeps them (P::keeps_low_parts); such a problem forms its differences with low_difference.
+  std::array<Vec<double, P::shape_dim>, P::order + 1> p_low = zero_nodes<P::shape_dim, P::order + 1>();
+
+  // (p[j] + p_low[j]) - (p[i] + p_low[i]) to the working precision of the difference.
+  Vec<T, P::shape_dim> low_difference(int j, int i) const {
+    return (p[j] - p[i]) + (p_low[j] - p_low[i]).template cast<T>();
+  }
 };
 
 namespace detail {

@@ -25,6 +25,9 @@ struct FlowState {
   std::array<Vec<double, P::shape_dim>, 2 * k> p;
   std::array<GroupElement<P, double>, 2 * k - 1> g;
   std::array<Vec<double, P::num_constraints>, k> lam;
+  // Low parts of the nodes (compensated.hpp): node i is p[i] + p_low[i]; zero unless the problem
+  // keeps them. Tangent coordinates move the sum.
+  std::array<Vec<double, P::shape_dim>, 2 * k> p_low = zero_nodes<P::shape_dim, 2 * k>();
 
   static constexpr int p_offset(int i) { return i * P::shape_dim; }
   static constexpr int g_offset(int i) { return 2 * k * P::shape_dim + i * P::Group::dim; }
@@ -37,6 +40,7 @@ struct FlowState {
 template <class P>
 struct StepUnknowns {
   Vec<double, P::shape_dim> p;      // p_{n+k}
+  Vec<double, P::shape_dim> p_low = Vec<double, P::shape_dim>::Zero();  // its low part (FlowState)
   GroupElement<P, double> g;        // g~_{n+k-1}
   Vec<double, P::num_constraints> lam;  // λ^n
 };
@@ -65,6 +69,8 @@ NodeBlock<P, T> step_block(const FlowState<P>& s, const StepUnknowns<P>& z, bool
   for (int i = 0; i < 2 * k; ++i)
     for (int a = 0; a < D::r; ++a) b.p[i](a) = seed_state ? var(s.p[i](a), nz + FS::p_offset(i) + a) : T(s.p[i](a));
   for (int a = 0; a < D::r; ++a) b.p[2 * k](a) = var(z.p(a), a);
+  for (int i = 0; i < 2 * k; ++i) b.p_low[i] = s.p_low[i];
+  b.p_low[2 * k] = z.p_low;
   for (int i = 0; i < 2 * k - 1; ++i) {
     b.g[i] = G::template cast<T>(s.g[i]);
     if (seed_state) {
@@ -184,7 +190,10 @@ template <class P>
 void apply_correction(StepUnknowns<P>& z, const Vec<double, Dims<P>::unknowns>& dz) {
   using D = Dims<P>;
   using G = typename P::Group;
-  z.p += dz.template head<D::r>();
+  if constexpr (keeps_low_parts<P>())
+    add_compensated(z.p, z.p_low, Vec<double, D::r>(dz.template head<D::r>()));
+  else
+    z.p += dz.template head<D::r>();
   const typename G::template Tangent<double> dzeta = dz.template segment<D::d>(D::r);
   z.g = G::compose(z.g, G::template exp<double>(dzeta));
   z.lam += dz.template tail<D::m>();
@@ -198,7 +207,12 @@ StepReport solve_step(const P& problem, double h, const FlowState<P>& s, int n, 
                       StepUnknowns<P>& z, ChordMatrix<Dims<P>::unknowns>* chord = nullptr) {
   using D = Dims<P>;
   constexpr int k = D::k, nz = D::unknowns;
-  z.p = 2.0 * s.p[2 * k - 1] - s.p[2 * k - 2];
+  if constexpr (keeps_low_parts<P>()) {
+    const Vec<double, D::r> twice = 2.0 * s.p[2 * k - 1], twice_low = 2.0 * s.p_low[2 * k - 1];
+    subtract_compensated(twice, twice_low, s.p[2 * k - 2], s.p_low[2 * k - 2], z.p, z.p_low);
+  } else {
+    z.p = 2.0 * s.p[2 * k - 1] - s.p[2 * k - 2];
+  }
   z.g = s.g[2 * k - 2];
   if constexpr (D::m > 0) z.lam = s.lam[k - 1];
   const Vec<double, D::node> fixed = step_fixed_part(problem, h, s, z);

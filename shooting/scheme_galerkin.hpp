@@ -69,8 +69,10 @@ struct GalerkinScheme {
   }
   static State end_state(const Run& run) { return {run.trajectory.intervals.back(), run.g_last}; }
 
-  // x = ref ⊕ δ; Jr: d(tangent at x)/dδ (identity but for the group blocks).
-  static State retract(const BVP& bvp, const State& ref, const Eigen::VectorXd& delta, Eigen::MatrixXd* Jr) {
+  // x = ref ⊕ δ, δ = Minv x_basis; Jr: d(tangent at x)/dδ (identity but for the group blocks).
+  static State retract(const BVP& bvp, const State& ref, const Eigen::VectorXd& x_basis, const Eigen::MatrixXd& Minv,
+                       Eigen::MatrixXd* Jr) {
+    const Eigen::VectorXd delta = Minv * x_basis;
     const double h = bvp.h();
     State x;
     x.iv = lpshoot::retract(ref.iv, Vec<double, ns>(delta.head<ns>()), h);

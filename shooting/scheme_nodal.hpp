@@ -35,7 +35,9 @@ NodeBlock<P, T> seeded_block(const BoundaryState<P>& x, GroupElement<P, T>& g_fi
   }
   for (int j = 0; j < k; ++j)
     for (int a = 0; a < m; ++a) b.lam[j](a) = T::variable(x.s.lam[j](a), FS::lam_offset(j) + a);
+  for (int i = 0; i < 2 * k; ++i) b.p_low[i] = x.s.p_low[i];
   b.p[2 * k] = b.p[2 * k - 1];
+  b.p_low[2 * k] = b.p_low[2 * k - 1];
   b.g[2 * k - 1] = b.g[2 * k - 2];
   b.lam[k] = b.lam[k - 1];
   typename G::template Tangent<T> delta;
@@ -90,6 +92,36 @@ BoundaryState<P> retract_extended(const BoundaryState<P>& ref, const Eigen::Vect
     block(ns);
   }
   return x;
+}
+
+// The same from unknowns x in the difference basis (δ = Minv x). A problem that keeps its nodes'
+// low parts (compensated.hpp) gets its nodes as ref + Σ_c Minv(·, c) x_c summed to twice the
+// working precision: node j is Newton's forward formula Σ_i C(j, i) h^i x_i, whose terms are the
+// differences the unknowns stand for, and rounding them as one δ_j would lose u |x_0| in every
+// difference (the shooting unknowns' own roundoff floor).
+template <class P>
+BoundaryState<P> retract_from_basis(const BoundaryState<P>& ref, const Eigen::VectorXd& x, const Eigen::MatrixXd& Minv,
+                                    Eigen::MatrixXd* Jr) {
+  BoundaryState<P> out = retract_extended(ref, Eigen::VectorXd(Minv * x), Jr);
+  if constexpr (keeps_low_parts<P>()) {
+    using FS = FlowState<P>;
+    constexpr int k = P::order, r = P::shape_dim;
+    for (int i = 0; i < 2 * k; ++i)
+      for (int a = 0; a < r; ++a) {
+        const int row = FS::p_offset(i) + a;
+        double sum = 0, err = 0;
+        for (Eigen::Index c = 0; c < x.size(); ++c) {
+          double t;
+          two_sum(sum, Minv(row, c) * x(c), sum, t);
+          err += t;
+        }
+        Vec<double, 1> hi(ref.s.p[i](a)), lo(ref.s.p_low[i](a));
+        add_compensated(hi, lo, Vec<double, 1>(sum));
+        add_compensated(hi, lo, Vec<double, 1>(err));
+        out.s.p[i](a) = hi(0), out.s.p_low[i](a) = lo(0);
+      }
+  }
+  return out;
 }
 
 template <class P>
@@ -228,21 +260,31 @@ struct NodalScheme {
   static State end_state(const Run& run) {
     return {run.trajectory.state(run.trajectory.N() - k + 1), run.g_first};
   }
-  static State retract(const BVP&, const State& ref, const Eigen::VectorXd& delta, Eigen::MatrixXd* Jr) {
-    return detail::retract_extended(ref, delta, Jr);
+  // x = ref ⊕ Minv x_basis (x_basis: unknowns in the difference basis).
+  static State retract(const BVP&, const State& ref, const Eigen::VectorXd& x_basis, const Eigen::MatrixXd& Minv,
+                       Eigen::MatrixXd* Jr) {
+    return detail::retract_from_basis(ref, x_basis, Minv, Jr);
   }
   static Eigen::VectorXd difference(const BVP&, const State& a, const State& b) { return detail::extended_difference(a, b); }
   static void difference_jacobians(const BVP&, const State& a, const State& b, Eigen::MatrixXd& Da, Eigen::MatrixXd& Db) {
     detail::difference_jacobians(a, b, Da, Db);
   }
   static Eigen::MatrixXd basis(const BVP& bvp) { return detail::difference_basis<P>(bvp.h()); }
-  // Magnitudes of the state's values (for the roundoff floor of rows).
+  // Magnitudes of the state's values (for the roundoff floor of rows). Nodes kept with their
+  // low parts (compensated.hpp) are rounded like their increments, not like their values.
   static Eigen::VectorXd magnitudes(const BVP& bvp, const State& x) {
     using G = typename P::Group;
     using FS = FlowState<P>;
     constexpr int r = P::shape_dim, d = G::dim, m = P::num_constraints;
     Eigen::VectorXd v = Eigen::VectorXd::Ones(size);
-    for (int j = 0; j < 2 * k; ++j) v.segment(FS::p_offset(j), r) = x.s.p[j].cwiseAbs().array().max(1.0);
+    for (int j = 0; j < 2 * k; ++j) {
+      if constexpr (keeps_low_parts<P>()) {
+        const int i = j + 1 < 2 * k ? j : j - 1;
+        v.segment(FS::p_offset(j), r) = (x.s.p[i + 1] - x.s.p[i]).cwiseAbs().array().max(bvp.h());
+      } else {
+        v.segment(FS::p_offset(j), r) = x.s.p[j].cwiseAbs().array().max(1.0);
+      }
+    }
     for (int j = 0; j < 2 * k - 1; ++j) v.segment(FS::g_offset(j), d) = G::log(x.s.g[j]).cwiseAbs().array().max(bvp.h());
     for (int j = 0; j < k; ++j) v.segment(FS::lam_offset(j), m) = x.s.lam[j].cwiseAbs().array().max(1.0);
     return v;
@@ -266,6 +308,7 @@ struct NodalScheme {
     for (size_t i = 1; i < runs.size(); ++i) {
       const Trajectory& t = runs[i].trajectory;
       tr.p.insert(tr.p.end(), t.p.begin() + 2 * k, t.p.end());
+      if (tr.has_low_parts() && t.has_low_parts()) tr.p_low.insert(tr.p_low.end(), t.p_low.begin() + 2 * k, t.p_low.end());
       tr.g.insert(tr.g.end(), t.g.begin() + 2 * k - 1, t.g.end());
       tr.lam.insert(tr.lam.end(), t.lam.begin() + k, t.lam.end());
     }

@@ -197,7 +197,7 @@ class ShootingSystem : public NonlinearSystem {
     starts.resize(S);
     Jr.resize(S);
     for (int i = 0; i < S; ++i) {
-      starts[i] = A::retract(bvp_, refs_[i], Eigen::VectorXd(Minv_ * x.segment(i * n, n)), sensitivities ? &Jr[i] : nullptr);
+      starts[i] = A::retract(bvp_, refs_[i], Eigen::VectorXd(x.segment(i * n, n)), Minv_, sensitivities ? &Jr[i] : nullptr);
       if (sensitivities) Jr[i] = Jr[i] * Minv_;  // d(tangent at the start)/d(unknowns)
     }
     // The flow propagates the unknowns' own directions (Jr), not the state's: in the nodal

@@ -310,3 +310,155 @@ TEST(PaperWindows, CentralNaturalConditionsAreSecondOrder) {
       EXPECT_NEAR(std::log2(err[i - 1] / err[i]), 2.0, 0.15) << "case " << static_cast<int>(f) << ", halving " << i;
   }
 }
+
+// The nodes' rounding is not amplified (core/compensated.hpp; METHOD.md §9, "store
+// increments"). On nodes rounded to doubles each new node is off by ~u |p| and the step's
+// recursion (order 4) grows that like n³: ~u |p| N^3.5 in all. On hi + lo nodes what is left is
+// the rounding of Δ²p in the step's residual, ~u |p''| h² per step, ~u |p''| T² N^1.5 in all.
+// PaperWindows<…, false> is the same scheme on rounded nodes: the floor this removes.
+template <WindowJet J, bool Low>
+using FreeElectron = PaperWindows<ElectronModel, J, Low>;
+
+// Exact oracle: without a field or potential ℓ = ½ m² |x''|² and both jets give Δ⁴p = 0, so the
+// flow continues the cubic through its first four nodes. Given them to twice the working
+// precision (p + p_low, from quadruple precision: long double's 64 bits would start the flow
+// 2^-64 |p| N³ ≈ 1e-9 away), the flow must stay on the cubic to ~1e-11 (N = 4000, T = 1).
+// Rounded to doubles, the same four nodes start a different cubic, u |p| N³ away.
+TEST(PaperWindows, ACubicFlowsWithoutTheNodesRoundoff) {
+  const ElectronModel model{1.3, 0.0, Eigen::Vector3d::Zero(), 0.0, 0.0};
+  const int N = 4000;
+  const double T = 1.0, h = T / N;
+#if defined(__SIZEOF_FLOAT128__) && !defined(__aarch64__)
+  using Wide = __float128;  // + - * / need no library
+#else
+  using Wide = long double;  // 113 bits where __float128 is not offered (aarch64)
+#endif
+  auto cubic = [&](int n, int a) {
+    const Wide t = static_cast<Wide>(n) / N;  // T = 1
+    const Wide c[3][4] = {{13, 4, -7, 2.5}, {-21, 0, 3, -5}, {9, -8, 0, 6}};  // tenths
+    return (c[a][0] + t * (c[a][1] + t * (c[a][2] + t * c[a][3]))) / 10;
+  };
+  auto flow_error = [&](const auto& problem) {
+    using P = std::decay_t<decltype(problem)>;
+    FlowState<P> s;
+    for (int i = 0; i < 4; ++i)
+      for (int a = 0; a < 3; ++a) {
+        s.p[i](a) = static_cast<double>(cubic(i, a));
+        if constexpr (keeps_low_parts<P>()) s.p_low[i](a) = static_cast<double>(cubic(i, a) - s.p[i](a));
+      }
+    const auto run = DiscreteFlow<P>(problem, h).run(s, N);
+    EXPECT_TRUE(run.report.ok()) << run.report.message;
+    EXPECT_EQ(run.trajectory.N(), N);
+    double err = 0;
+    for (int n = 0; n <= run.trajectory.N(); ++n)
+      for (int a = 0; a < 3; ++a) {
+        Wide x = run.trajectory.p[n](a);
+        if (run.trajectory.has_low_parts()) x += run.trajectory.p_low[n](a);
+        err = std::max(err, std::abs(static_cast<double>(x - cubic(n, a))));
+      }
+    return err;
+  };
+  const double forward = flow_error(FreeElectron<WindowJet::Forward, true>{model}),
+               central = flow_error(FreeElectron<WindowJet::Central, true>{model}),
+               rounded = flow_error(FreeElectron<WindowJet::Central, false>{model});
+  std::printf("cubic over N = %d steps: forward windows %.2e, central %.2e; central on rounded nodes %.2e\n", N, forward,
+              central, rounded);
+  EXPECT_LT(forward, 1e-10);
+  EXPECT_LT(central, 1e-10);
+  EXPECT_GT(rounded, 1000 * central);
+}
+
+// A nonlinear flow and back: with B = 0 the electron's ℓ = ½ |m x'' + 2φ x + 4 c x1³ e1|² is
+// even in time, and so is the central jet: run N = 4000 steps, then from the last four nodes
+// reversed (low parts included) run N steps again; in exact arithmetic the flow returns to its
+// first nodes, so the difference is the roundoff the flows accumulated.
+TEST(PaperWindows, ANonlinearFlowReturnsToItsStartToRoundoff) {
+  const ElectronModel model{1.1, 0.0, Eigen::Vector3d::Zero(), 0.8, 0.3};
+  const int N = 4000;
+  const double T = 2.0, h = T / N;
+  auto round_trip = [&](const auto& problem) {
+    using P = std::decay_t<decltype(problem)>;
+    FlowState<P> s;
+    for (int i = 0; i < 4; ++i) {
+      const double t = i * h;
+      s.p[i] = Eigen::Vector3d(1.0 + 0.2 * t * t, 0.5 * t, 0.3 * t - 0.1 * t * t);
+    }
+    const DiscreteFlow<P> flow(problem, h);
+    const auto there = flow.run(s, N);
+    EXPECT_TRUE(there.report.ok()) << there.report.message;
+    FlowState<P> back;
+    for (int i = 0; i < 4; ++i) {
+      back.p[i] = there.trajectory.p[N - i];
+      if (there.trajectory.has_low_parts()) back.p_low[i] = there.trajectory.p_low[N - i];
+    }
+    const auto again = flow.run(back, N);
+    EXPECT_TRUE(again.report.ok()) << again.report.message;
+    double err = 0, size = 0;
+    for (int n = 0; n <= N; ++n) size = std::max(size, there.trajectory.p[n].template lpNorm<Eigen::Infinity>());
+    for (int i = 0; i < 4; ++i) {
+      Eigen::Vector3d d = again.trajectory.p[N - i] - s.p[i];
+      if (again.trajectory.has_low_parts()) d += again.trajectory.p_low[N - i];
+      err = std::max(err, d.template lpNorm<Eigen::Infinity>());
+    }
+    std::printf("nonlinear electron, N = %d there and back (|x| up to %.2f): %s nodes return to %.2e\n", N, size,
+                keeps_low_parts<P>() ? "hi + lo" : "rounded", err);
+    return err;
+  };
+  const double low = round_trip(FreeElectron<WindowJet::Central, true>{model});
+  const double rounded = round_trip(FreeElectron<WindowJet::Central, false>{model});
+  EXPECT_LT(low, 1e-9);
+  EXPECT_GT(rounded, 100 * low);
+}
+
+// The shooting unknowns and continuity defects keep the nodes' low parts too
+// (scheme_nodal.hpp, retract_from_basis): the same cubic as a boundary value problem, its first
+// and last two nodes given, solved at tolerance 1e-12 with 4 and 40 segments of N = 4000 steps.
+// The discrete optimum is the cubic through the given nodes, within ~u N of the continuous one.
+TEST(PaperWindows, ShootingReachesTheCubicBelowTheNodalFloor) {
+  const ElectronModel model{1.3, 0.0, Eigen::Vector3d::Zero(), 0.0, 0.0};
+  const int N = 4000;
+  const double T = 1.0, h = T / N;
+  auto cubic = [](double t) {
+    return Eigen::Vector3d(1.3 + 0.4 * t - 0.7 * t * t + 0.25 * t * t * t, -2.1 + 0.3 * t * t - 0.5 * t * t * t,
+                           0.9 - 0.8 * t + 0.6 * t * t * t);
+  };
+  auto solve_error = [&](const auto& problem, int segments) {
+    using P = std::decay_t<decltype(problem)>;
+    BoundaryValueProblem<P> bvp{problem, N, T, {}};
+    for (int i = 0; i < 3; ++i)
+      for (int o : {0, 1}) {
+        bvp.fix_shape(End::Initial, o, i, cubic(o * h)(i), "initial node " + std::to_string(o));
+        bvp.fix_shape(End::Terminal, o, i, cubic(T - o * h)(i), "terminal node " + std::to_string(o));
+      }
+    ShootingGuess<P> guess;
+    guess.trajectory.h = h;
+    for (int n = 0; n <= N; ++n) {  // the chord between the ends
+      const double s = double(n) / N;
+      guess.trajectory.p.push_back((1 - s) * cubic(0) + s * cubic(T));
+    }
+    guess.trajectory.lam.assign(N - 1, Vec<double, 0>());
+    ShootingOptions opt;
+    opt.method = ShootingMethod::Multiple;
+    opt.segments = segments;
+    opt.solver.tolerance = 1e-12;
+    const auto r = solve_bvp(bvp, guess, opt);
+    double err = std::numeric_limits<double>::infinity();
+    if (r.ok()) {
+      err = 0;
+      for (int n = 0; n <= N; ++n) {
+        Eigen::Vector3d x = r.trajectory.p[n];
+        if (r.trajectory.has_low_parts()) x += r.trajectory.p_low[n];
+        err = std::max(err, (x - cubic(n * h)).lpNorm<Eigen::Infinity>());
+      }
+    }
+    std::printf("cubic as a BVP, N = %d, %d segments, %s nodes: %s, max node error %.2e\n", N, segments,
+                keeps_low_parts<P>() ? "hi + lo" : "rounded", r.ok() ? "converged" : r.message.c_str(), err);
+    return err;
+  };
+  for (int segments : {4, 40}) {
+    const double low = solve_error(FreeElectron<WindowJet::Central, true>{model}, segments);
+    const double rounded = solve_error(FreeElectron<WindowJet::Central, false>{model}, segments);
+    EXPECT_LT(low, 1e-10) << segments << " segments";
+    EXPECT_GT(rounded, 100 * low) << segments << " segments (rounded nodes)";
+  }
+}
