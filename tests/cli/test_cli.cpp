@@ -372,12 +372,13 @@ TEST(ModelProblems, SphericalPendulumFromOneFileSolvesAndConservesItsAngularMome
   }
   for (size_t i = 1; i < p_drift.size(); ++i) EXPECT_NEAR(std::log2(p_drift[i - 1] / p_drift[i]), 2.0, 0.2) << "P drift, halving " << i;
 
-  // One segment of 80 steps at tolerance 1e-11: the first full Newton step from the boundary
-  // curve raises the residual and the line search crawls (5.8e8 x tolerance after 49
-  // iterations, when no more segments are to be tried), far above the scheme's roundoff floor (1.6e4 x tolerance). The message says so
-  // and names the remedy, which works: two segments converge in 4 iterations.
+  // One segment of 80 steps at tolerance 1e-12: the first full Newton step from the boundary
+  // curve raises the residual and the line search crawls (1.1e10 x tolerance at the end, when no
+  // more segments are to be tried; at 1e-11 it converges since the nodes keep their low parts,
+  // whose smaller row floors weigh the line search's merit differently: bench/RESULTS.md). The
+  // message says so and names the remedy, which works: two segments converge in 5 iterations.
   const std::string tight = "solve '" + scene("spherical_pendulum") +
-                            "' --set 'scheme={\"discretization\": \"paper\"}' --set horizon.N=80 --set solver.tolerance=1e-11 --no-plot ";
+                            "' --set 'scheme={\"discretization\": \"paper\"}' --set horizon.N=80 --set solver.tolerance=1e-12 --no-plot ";
   const Outcome one = run_cli(tight + "--set solver.segments=1 --out '" + (work / "one").string() + "'", work);
   EXPECT_EQ(one.code, 1) << one.out << one.err;
   const json fr = json::parse(std::ifstream(work / "one" / "report.json"));
@@ -401,11 +402,12 @@ TEST(ModelProblems, SphericalPendulumFromOneFileSolvesAndConservesItsAngularMome
       << ar["detail"];
   EXPECT_GT(ar["iterations"].get<int>(), tr["iterations"].get<int>());  // the failed attempt's iterations count
   // With more segments to try, the one-segment attempt's line search stops once it crawls (less
-  // than a 2-fold cut in 5 iterations): both attempts take fewer iterations than the explicit
-  // one-segment run, which has no remedy left and crawls on.
+  // than a 2-fold cut in 5 iterations): it takes fewer iterations than the explicit one-segment
+  // run, which has no remedy left and crawls on (8 against 13).
   EXPECT_NE(ar["detail"].get<std::string>().find("stopped when it crawled"), std::string::npos) << ar["detail"];
   EXPECT_EQ(fr.value("detail", std::string()).find("stopped when it crawled"), std::string::npos) << fr["detail"];
-  EXPECT_LT(ar["iterations"].get<int>(), fr["iterations"].get<int>()) << ar["iterations"] << " " << fr["iterations"];
+  EXPECT_LT(ar["iterations"].get<int>() - tr["iterations"].get<int>(), fr["iterations"].get<int>())
+      << ar["iterations"] << " " << tr["iterations"] << " " << fr["iterations"];
   EXPECT_NEAR(ar["cost"].get<double>(), tr["cost"].get<double>(), 1e-12 * std::abs(tr["cost"].get<double>()));
   for (const char* key : {"phi", "theta"})
     EXPECT_NEAR(ar["final_state"][key].get<double>(), tr["final_state"][key].get<double>(), 1e-12) << key;
