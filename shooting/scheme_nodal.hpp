@@ -238,6 +238,9 @@ struct NodalScheme {
     if (guess.trajectory.N() != bvp.N || static_cast<int>(guess.trajectory.lam.size()) != bvp.N - k + 1)
       return "the initial guess has N = " + std::to_string(guess.trajectory.N()) + ", the problem N = " +
              std::to_string(bvp.N);
+    if (static_cast<int>(guess.trajectory.g.size()) != bvp.N)
+      return "the initial guess has " + std::to_string(guess.trajectory.g.size()) + " group increments g~, expected N = " +
+             std::to_string(bvp.N);
     return "";
   }
   // The guess's states at the given indices.

@@ -436,6 +436,7 @@ TEST(PaperWindows, ShootingReachesTheCubicBelowTheNodalFloor) {
       const double s = double(n) / N;
       guess.trajectory.p.push_back((1 - s) * cubic(0) + s * cubic(T));
     }
+    guess.trajectory.g.assign(N, Trivial::identity<double>());
     guess.trajectory.lam.assign(N - 1, Vec<double, 0>());
     ShootingOptions opt;
     opt.method = ShootingMethod::Multiple;
@@ -461,4 +462,20 @@ TEST(PaperWindows, ShootingReachesTheCubicBelowTheNodalFloor) {
     EXPECT_LT(low, 1e-10) << segments << " segments";
     EXPECT_GT(rounded, 100 * low) << segments << " segments (rounded nodes)";
   }
+  // A guess without its increments g~ (one per interval, identities here) is refused, naming
+  // them: it used to be read past its end.
+  using P = FreeElectron<WindowJet::Central, true>;
+  BoundaryValueProblem<P> bvp{P{model}, 40, T, {}};
+  for (int i = 0; i < 3; ++i)
+    for (int o : {0, 1}) {
+      bvp.fix_shape(End::Initial, o, i, 0.0, "initial node " + std::to_string(o));
+      bvp.fix_shape(End::Terminal, o, i, 1.0, "terminal node " + std::to_string(o));
+    }
+  ShootingGuess<P> guess;
+  guess.trajectory.h = bvp.h();
+  guess.trajectory.p.assign(41, Eigen::Vector3d::Zero());
+  guess.trajectory.lam.assign(39, Vec<double, 0>());
+  const auto r = solve_bvp(bvp, guess, ShootingOptions{});
+  EXPECT_EQ(r.status, ShootingStatus::InvalidProblem);
+  EXPECT_NE(r.message.find("0 group increments g~, expected N = 40"), std::string::npos) << r.message;
 }
