@@ -20,6 +20,7 @@
 
 #include "galerkin.hpp"
 #include "galerkin_flat.hpp"
+#include "group_velocity_hessian.hpp"
 #include "hessian_scalar.hpp"
 
 namespace lpshoot {
@@ -146,6 +147,18 @@ void embed(Hess<N>& e, const Hess<M>& a, int first) {
   }
 }
 
+// e += a, with a as in embed.
+template <int N, int M>
+void add_embedded(Hess<N>& e, const Hess<M>& a, int first) {
+  e.v += a.v;
+  int k = 0;
+  for (int i = 0; i < M; ++i) {
+    e.g[first + i] += a.g[i];
+    double* row = &e.H[Hess<N>::at(first + i, first + i)];
+    for (int j = i; j < M; ++j, ++k) row[j - i] += a.H[k];
+  }
+}
+
 // The group curve's ends e(y) in Hess<4r + 3d> over (x, v, Ω, X2, V1, O1, δ), the first
 // 4r + 3d directions of group_curve_ends of seeded_state(iv, h, 0). ζ = log(W exp(h δ)) depends on
 // δ alone: its group operations run in Hess<d> and are embedded, instead of in all 4r + 3d
@@ -174,7 +187,26 @@ GroupCurveEnds<Sch, Hess<4 * Sch::r + 3 * Sch::d>> seeded_group_curve_ends(const
     X2(a) = T::variable(iv.X2(a), Sch::X2_off + a);
     V1(a) = T::variable(iv.V1(a), Sch::V1_off + a);
   }
-  return group_curve_ends_from<Sch, T>(model, zeta, x, v, X2, V1, Om, O1, h);
+  // group_curve_ends_from, with ω1 = Jr(ζ)^{-1} y (y the end velocity) taken as a function of
+  // its 2d arguments in Hess<2d> and composed: ζ depends on δ alone and y on a few coordinates,
+  // so the composition touches few entries where Hess<4r + 3d> arithmetic touched all.
+  GroupCurveEnds<Sch, T> e;
+  e.zeta = zeta;
+  e.omega0 = Om - connection_velocity_of(model, x, v);
+  const Vec<T, r> x_end = x + h * v + (h * h) * X2, v_end = v + h * V1;
+  const Vec<T, d> y = (Om + h * O1) - connection_velocity_of(model, x_end, v_end);
+  using TF = Hess<2 * d>;
+  typename G::template Tangent<TF> zf, yf;
+  const T* args[2 * d];
+  for (int a = 0; a < d; ++a) {
+    zf(a) = TF::variable(zeta(a).v, a);
+    yf(a) = TF::variable(y(a).v, d + a);
+    args[a] = &e.zeta(a);
+    args[d + a] = &y(a);
+  }
+  const typename G::template Tangent<TF> F = right_jacobian_inverse_times<G, TF>(zf, yf);
+  for (int a = 0; a < d; ++a) e.omega1(a) = detail::compose_sparse<n, 2 * d>(F(a), args);
+  return e;
 }
 
 // jet_from_inputs at the jet inputs u = (p, p', p'', ξ, ξ', ξ'') (JetInputMaps' order), seeded
@@ -193,18 +225,42 @@ Jet<typename Sch::Model, Hess<3 * Sch::r + 3 * Sch::d>> seeded_jet(const typenam
     q.dp(a).v = u(r + a), q.dp(a).g[r + a] = 1.0;
     q.ddp(a).v = u(2 * r + a), q.ddp(a).g[2 * r + a] = 1.0;
   }
-  Vec<TX, d> xi0, xi1, xi2, Om, dOm;
-  for (int a = 0; a < d; ++a) {
-    xi0(a) = TX::variable(u(3 * r + a), a);
-    xi1(a) = TX::variable(u(3 * r + d + a), d + a);
-    xi2(a) = TX::variable(u(3 * r + 2 * d + a), 2 * d + a);
+  using G = typename Sch::Group;
+  if constexpr (SeededVelocity<G>::available) {
+    // Closed form, straight into the jet's directions (group_velocity_hessian.hpp).
+    const auto idx = [](int k, int a) { return 3 * r + k * d + a; };
+    SeededVelocity<G>::template jet<nu>(u.data() + 3 * r, u.data() + 3 * r + d, u.data() + 3 * r + 2 * d, idx,
+                                        q.Omega.data(), q.dOmega.data());
+  } else {
+    Vec<TX, d> xi0, xi1, xi2, Om, dOm;
+    for (int a = 0; a < d; ++a) {
+      xi0(a) = TX::variable(u(3 * r + a), a);
+      xi1(a) = TX::variable(u(3 * r + d + a), d + a);
+      xi2(a) = TX::variable(u(3 * r + 2 * d + a), 2 * d + a);
+    }
+    body_velocity_jet<G, TX>(xi0, xi1, xi2, Om, dOm);
+    for (int a = 0; a < d; ++a) {
+      embed(q.Omega(a), Om(a), 3 * r);
+      embed(q.dOmega(a), dOm(a), 3 * r);
+    }
   }
-  body_velocity_jet<typename Sch::Group, TX>(xi0, xi1, xi2, Om, dOm);
-  for (int a = 0; a < d; ++a) {
-    embed(q.Omega(a), Om(a), 3 * r);
-    embed(q.dOmega(a), dOm(a), 3 * r);
+  // + 𝒜(p) p' and its time derivative: functions of (p, p', p''), the first 3r directions, run
+  // in Hess<3r> and added (the beanie's constant 𝒜 made full Hess<3r + 3d> sums).
+  if constexpr (detail::HasConnectionForm<typename Sch::Model, Hess<3 * r>>::value) {
+    using TP = Hess<3 * r>;
+    Vec<TP, r> p, dp, ddp;
+    for (int a = 0; a < r; ++a) {
+      p(a) = TP::variable(u(a), a);
+      dp(a) = TP::variable(u(r + a), r + a);
+      ddp(a) = TP::variable(u(2 * r + a), 2 * r + a);
+    }
+    Vec<TP, d> cv, dcv;
+    connection_jet(model, p, dp, ddp, cv, dcv);
+    for (int a = 0; a < d; ++a) {
+      add_embedded(q.Omega(a), cv(a), 0);
+      add_embedded(q.dOmega(a), dcv(a), 0);
+    }
   }
-  add_connection_part<Sch, T>(model, q);
   return q;
 }
 

@@ -252,6 +252,39 @@ Hess<A> lift_multivariate_hess(const Dual<Dual<double, n>, n>& f, const V& x) {
   // f_kl = f_lk, so the upper triangle holds the full second-order term.
   return r;
 }
+
+// f(x_0, ..., x_{M-1}) given as Hess<M> in its arguments, composed with arguments x_k in Hess<N>:
+// the rule above, summed over each argument's non-zero gradient entries only (arguments that
+// depend on a few of the N directions, as a group curve's ends do: galerkin_group_interval.hpp).
+template <int N, int M>
+Hess<N> compose_sparse(const Hess<M>& f, const Hess<N>* const* x) {
+  Hess<N> r(f.v);
+  std::array<std::array<int, N>, M> nz;
+  std::array<int, M> count{};
+  for (int k = 0; k < M; ++k) {
+    for (int i = 0; i < N; ++i)
+      if (x[k]->g[i] != 0.0) nz[k][count[k]++] = i;
+    const double fk = f.g[k];
+    if (fk == 0.0) continue;
+    for (int c = 0; c < count[k]; ++c) r.g[nz[k][c]] += fk * x[k]->g[nz[k][c]];
+    for (int p = 0; p < Hess<N>::packed; ++p) r.H[p] += fk * x[k]->H[p];
+  }
+  // Σ over ordered (k, l) of f_kl x_k'(i) x_l'(j), i <= j: the (l, k) term supplies i > j.
+  for (int k = 0; k < M; ++k)
+    for (int l = 0; l < M; ++l) {
+      const double fkl = f.hessian(k, l);
+      if (fkl == 0.0) continue;
+      for (int a = 0; a < count[k]; ++a) {
+        const int i = nz[k][a];
+        const double s = fkl * x[k]->g[i];
+        for (int b = 0; b < count[l]; ++b) {
+          const int j = nz[l][b];
+          if (i <= j) r.H[Hess<N>::at(i, j)] += s * x[l]->g[j];
+        }
+      }
+    }
+  return r;
+}
 }  // namespace detail
 
 }  // namespace lpshoot

@@ -2,6 +2,7 @@
 // functions evaluated directly in the nested type: every value, first, second and third
 // derivative, Taylor coefficients included.
 #include <lpshoot/core/group_jets.hpp>
+#include <lpshoot/core/group_velocity_hessian.hpp>
 #include <lpshoot/core/groups.hpp>
 
 #include <gtest/gtest.h>
@@ -161,5 +162,62 @@ TEST(ScalarTower, ClosedFormBodyVelocityAndJacobianInverseMatchTheGroupsExpAndLo
     expect_closed_form_velocity_matches_generic<SO2>(angle);
     expect_closed_form_velocity_matches_generic<Rn<2>>(angle);
     expect_closed_form_velocity_matches_generic<Product<SE2, SO2>>(angle);
+  }
+}
+
+namespace {
+// The seeded closed form (group_velocity_hessian.hpp) against the closed form run in Hess<3d>
+// arithmetic, its variables placed at 1 + (k d + a) of Hess<3d + 2>: every value, gradient and
+// Hessian entry, including the directions the body velocity does not depend on (zero).
+template <class G>
+void expect_seeded_velocity_matches_hess_arithmetic(double angle) {
+  static_assert(SeededVelocity<G>::available);
+  constexpr int d = G::dim, n = 3 * d, N = n + 2;
+  using TX = Hess<n>;
+  using T = Hess<N>;
+  double x[3][d];
+  for (int a = 0; a < d; ++a) {
+    x[0][a] = a == d - 1 ? angle : 0.4 - 0.3 * a;
+    x[1][a] = 0.7 - 0.6 * a;
+    x[2][a] = -0.4 + 0.35 * a;
+  }
+  typename G::template Tangent<TX> x0, x1, x2, Om_ref, dOm_ref;
+  for (int a = 0; a < d; ++a) {
+    x0(a) = TX::variable(x[0][a], a);
+    x1(a) = TX::variable(x[1][a], d + a);
+    x2(a) = TX::variable(x[2][a], 2 * d + a);
+  }
+  GroupVelocity<G>::template jet<TX>(x0, x1, x2, Om_ref, dOm_ref);
+  T Om[d], dOm[d];
+  const auto idx = [](int k, int a) { return 1 + k * d + a; };
+  SeededVelocity<G>::template jet<N>(x[0], x[1], x[2], idx, Om, dOm);
+  auto check = [&](const T& got, const TX& ref, const char* what) {
+    SCOPED_TRACE(what);
+    const double tol = 1e-14;
+    EXPECT_NEAR(got.v, ref.v, tol * (1 + std::abs(ref.v)));
+    EXPECT_EQ(got.g[0], 0.0);
+    EXPECT_EQ(got.g[N - 1], 0.0);
+    for (int i = 0; i < N; ++i)
+      for (int j = i; j < N; ++j) {
+        const bool inside = i >= 1 && j >= 1 && i <= n && j <= n;
+        const double want = inside ? ref.hessian(i - 1, j - 1) : 0.0;
+        EXPECT_NEAR(got.hessian(i, j), want, tol * (1 + std::abs(want))) << "H(" << i << ", " << j << ")";
+        if (i == j && inside) EXPECT_NEAR(got.g[i], ref.g[i - 1], tol * (1 + std::abs(ref.g[i - 1])));
+      }
+  };
+  for (int a = 0; a < d; ++a) {
+    check(Om[a], Om_ref(a), "Omega");
+    check(dOm[a], dOm_ref(a), "dOmega");
+  }
+}
+}  // namespace
+
+TEST(ScalarTower, SeededBodyVelocityHessianMatchesTheClosedFormInHessArithmetic) {
+  for (double angle : {0.0, 1e-9, 1e-5, 0.02, 0.3, 0.49, 0.51, 0.7, 0.99, 1.01, 1.3, 2.5, -1.9}) {
+    SCOPED_TRACE(angle);
+    expect_seeded_velocity_matches_hess_arithmetic<SE2>(angle);
+    expect_seeded_velocity_matches_hess_arithmetic<SO2>(angle);
+    expect_seeded_velocity_matches_hess_arithmetic<Rn<2>>(angle);
+    expect_seeded_velocity_matches_hess_arithmetic<Product<SE2, SO2>>(angle);
   }
 }
