@@ -202,7 +202,9 @@ void expect_seeded_velocity_matches_hess_arithmetic(double angle) {
         const bool inside = i >= 1 && j >= 1 && i <= n && j <= n;
         const double want = inside ? ref.hessian(i - 1, j - 1) : 0.0;
         EXPECT_NEAR(got.hessian(i, j), want, tol * (1 + std::abs(want))) << "H(" << i << ", " << j << ")";
-        if (i == j && inside) EXPECT_NEAR(got.g[i], ref.g[i - 1], tol * (1 + std::abs(ref.g[i - 1])));
+        if (i == j && inside) {
+          EXPECT_NEAR(got.g[i], ref.g[i - 1], tol * (1 + std::abs(ref.g[i - 1])));
+        }
       }
   };
   for (int a = 0; a < d; ++a) {
