@@ -78,9 +78,18 @@ struct GroupCurveEnds {
   Vec<T, Sch::d> zeta, omega0, omega1;
 };
 
-// The ends from ζ = log W and the interval's base node and increments (the interval's x_end,
-// v_end and Om_end, written out so that ζ can come from elsewhere: galerkin_group_interval.hpp
-// differentiates ζ, which depends on W alone, in its own few directions).
+// The group curve's velocity at the interval's end, Ω_end − 𝒜(x_end) v_end, from its base node
+// and increments (the interval's x_end, v_end and Om_end, written out: galerkin_group_interval.hpp
+// calls it on separately seeded coordinates).
+template <class Sch, class T>
+Vec<T, Sch::d> group_curve_end_velocity(const typename Sch::Model& model, const Vec<T, Sch::r>& x,
+                                        const Vec<T, Sch::r>& v, const Vec<T, Sch::r>& X2, const Vec<T, Sch::r>& V1,
+                                        const Vec<T, Sch::d>& Om, const Vec<T, Sch::d>& O1, double h) {
+  const Vec<T, Sch::r> x_end = x + h * v + (h * h) * X2, v_end = v + h * V1;
+  return (Om + h * O1) - connection_velocity_of(model, x_end, v_end);
+}
+
+// The ends from ζ = log W and the interval's base node and increments.
 template <class Sch, class T>
 GroupCurveEnds<Sch, T> group_curve_ends_from(const typename Sch::Model& model, const Vec<T, Sch::d>& zeta,
                                              const Vec<T, Sch::r>& x, const Vec<T, Sch::r>& v,
@@ -89,8 +98,7 @@ GroupCurveEnds<Sch, T> group_curve_ends_from(const typename Sch::Model& model, c
   GroupCurveEnds<Sch, T> e;
   e.zeta = zeta;
   e.omega0 = Om - connection_velocity_of(model, x, v);
-  const Vec<T, Sch::r> x_end = x + h * v + (h * h) * X2, v_end = v + h * V1;
-  const Vec<T, Sch::d> end_velocity = (Om + h * O1) - connection_velocity_of(model, x_end, v_end);
+  const Vec<T, Sch::d> end_velocity = group_curve_end_velocity<Sch, T>(model, x, v, X2, V1, Om, O1, h);
   e.omega1 = right_jacobian_inverse_times<typename Sch::Group, T>(zeta, end_velocity);
   return e;
 }

@@ -193,8 +193,7 @@ GroupCurveEnds<Sch, Hess<4 * Sch::r + 3 * Sch::d>> seeded_group_curve_ends(const
   GroupCurveEnds<Sch, T> e;
   e.zeta = zeta;
   e.omega0 = Om - connection_velocity_of(model, x, v);
-  const Vec<T, r> x_end = x + h * v + (h * h) * X2, v_end = v + h * V1;
-  const Vec<T, d> y = (Om + h * O1) - connection_velocity_of(model, x_end, v_end);
+  const Vec<T, d> y = group_curve_end_velocity<Sch, T>(model, x, v, X2, V1, Om, O1, h);
   using TF = Hess<2 * d>;
   typename G::template Tangent<TF> zf, yf;
   const T* args[2 * d];
