@@ -72,6 +72,33 @@ static void BM_BeanieControlStep_EngineWithSensitivity(benchmark::State& st) {
 }
 BENCHMARK(BM_BeanieControlStep_EngineWithSensitivity);
 
+// As a flow's steps run it: windows a_{n-k} .. a_{n-1}'s Hessians carried from the previous
+// steps (step_window_hessian.hpp), a_n's computed; Newton starts with chord iterations on the
+// previous step's factored matrix (newton.hpp), here the same step's.
+template <class P>
+static void step_as_in_a_flow(benchmark::State& st, const P& problem, const FlowState<P>& s, double h) {
+  const NewtonOptions opt;
+  StepUnknowns<P> z;
+  WindowHessianCarry<P> carry;
+  ChordMatrix<Dims<P>::unknowns> previous;
+  solve_step(problem, h, s, 2, opt, z);
+  step_sensitivity(problem, h, s, z, &previous, nullptr, &carry, 2);
+  int iterations = 0;
+  for (auto _ : st) {
+    ChordMatrix<Dims<P>::unknowns> chord = previous;
+    iterations = solve_step(problem, h, s, 2, opt, z, &chord).iterations;
+    auto dz = step_sensitivity(problem, h, s, z, &chord, nullptr, &carry, 2);
+    benchmark::DoNotOptimize(dz);
+  }
+  st.counters["newton_iterations"] = iterations;
+}
+
+static void BM_BeanieControlStep_EngineWithSensitivityAsInAFlow(benchmark::State& st) {
+  const BeanieControl b = beanie();
+  step_as_in_a_flow(st, b, beanie_state(b, 0.01), 0.01);
+}
+BENCHMARK(BM_BeanieControlStep_EngineWithSensitivityAsInAFlow);
+
 // The hand-written tangent-linear step (tests/oracles/analytic_steps.cpp): value and dz/d(state).
 static void BM_BeanieControlStep_AnalyticWithSensitivity(benchmark::State& st) {
   const BeanieControl b = beanie();
@@ -124,6 +151,12 @@ static void BM_BeanieDerivedWindowsStep_EngineWithSensitivity(benchmark::State& 
   }
 }
 BENCHMARK(BM_BeanieDerivedWindowsStep_EngineWithSensitivity);
+
+static void BM_BeanieDerivedWindowsStep_EngineWithSensitivityAsInAFlow(benchmark::State& st) {
+  const DerivedBeanie b{problems::BeanieModel{beanie().par}};
+  step_as_in_a_flow(st, b, derived_beanie_state(0.01), 0.01);
+}
+BENCHMARK(BM_BeanieDerivedWindowsStep_EngineWithSensitivityAsInAFlow);
 
 static void BM_ElectronStep_Engine(benchmark::State& st) {
   const Electron e;

@@ -154,13 +154,14 @@ class DiscreteFlow {
     Eigen::Matrix<double, D::unknowns, ns> dz;
     double condition = 0;  // dz's step matrix's
     bool dz_current = false;
+    WindowHessianCarry<P> windows;  // each window's Hessian, shared by the k + 1 steps it enters
     for (int n = k; n <= N - k; ++n) {
       StepUnknowns<P> z;
-      if (!rep.add(solve_step(problem_, h_, s, n, options_, z, chord_used))) return out;
+      if (!rep.add(solve_step(problem_, h_, s, n, options_, z, chord_used, seed ? &windows : nullptr))) return out;
       if (seed) {
         // New state = shifted old state + z; the new rows come from the implicit function theorem.
         if (!dz_current) {
-          dz = step_sensitivity(problem_, h_, s, z, &chord, &condition);
+          dz = step_sensitivity(problem_, h_, s, z, &chord, &condition, &windows, n);
           dz_current = affine_;
         }
         rep.max_condition = std::max(rep.max_condition, condition);

@@ -134,31 +134,6 @@ const JetInputMaps<Sch>& jet_input_maps(double h) {
   return maps;
 }
 
-// a, a function of M variables, as a function of N >= M whose variables first .. first + M - 1
-// are a's, written into e, which must be zero.
-template <int N, int M>
-void embed(Hess<N>& e, const Hess<M>& a, int first) {
-  e.v = a.v;
-  int k = 0;
-  for (int i = 0; i < M; ++i) {
-    e.g[first + i] = a.g[i];
-    double* row = &e.H[Hess<N>::at(first + i, first + i)];
-    for (int j = i; j < M; ++j, ++k) row[j - i] = a.H[k];
-  }
-}
-
-// e += a, with a as in embed.
-template <int N, int M>
-void add_embedded(Hess<N>& e, const Hess<M>& a, int first) {
-  e.v += a.v;
-  int k = 0;
-  for (int i = 0; i < M; ++i) {
-    e.g[first + i] += a.g[i];
-    double* row = &e.H[Hess<N>::at(first + i, first + i)];
-    for (int j = i; j < M; ++j, ++k) row[j - i] += a.H[k];
-  }
-}
-
 // The group curve's ends e(y) in Hess<4r + 3d> over (x, v, Ω, X2, V1, O1, δ), the first
 // 4r + 3d directions of group_curve_ends of seeded_state(iv, h, 0). ζ = log(W exp(h δ)) depends on
 // δ alone: its group operations run in Hess<d> and are embedded, instead of in all 4r + 3d

@@ -209,6 +209,26 @@ void add_product(Hess<N>& acc, double c, const Hess<N>& a, const Hess<N>& b) {
   acc.v += cav * b.v;
 }
 
+// e += a, with a (a function of M variables) taken as a function of N >= M whose variables
+// first .. first + M - 1 are a's.
+template <int N, int M>
+void add_embedded(Hess<N>& e, const Hess<M>& a, int first) {
+  e.v += a.v;
+  int k = 0;
+  for (int i = 0; i < M; ++i) {
+    e.g[first + i] += a.g[i];
+    double* row = &e.H[Hess<N>::at(first + i, first + i)];
+    for (int j = i; j < M; ++j, ++k) row[j - i] += a.H[k];
+  }
+}
+
+// e = a, as in add_embedded.
+template <int N, int M>
+void embed(Hess<N>& e, const Hess<M>& a, int first) {
+  e = Hess<N>();
+  add_embedded(e, a, first);
+}
+
 template <int N>
 struct derivative_order<Hess<N>> : std::integral_constant<int, 2> {};
 
@@ -284,6 +304,20 @@ Hess<N> compose_sparse(const Hess<M>& f, const Hess<N>* const* x) {
       }
     }
   return r;
+}
+
+// f, a function of M scalar arguments written for any scalar type and returning K of them, at
+// arguments given in Hess<N>: f runs in Hess<M> at the arguments' values and each output is
+// composed with the arguments (compose_sparse). Worth it when M < N and f is more than a few
+// operations: a group's log and exp then run in M directions instead of N.
+template <int N, int M, int K, class F>
+Eigen::Matrix<Hess<N>, K, 1> compose_through(const std::array<const Hess<N>*, M>& x, F&& f) {
+  std::array<Hess<M>, M> seeded;
+  for (int k = 0; k < M; ++k) seeded[k] = Hess<M>::variable(x[k]->v, k);
+  const Eigen::Matrix<Hess<M>, K, 1> y = f(seeded);
+  Eigen::Matrix<Hess<N>, K, 1> out;
+  for (int i = 0; i < K; ++i) out(i) = compose_sparse<N, M>(y(i), x.data());
+  return out;
 }
 }  // namespace detail
 

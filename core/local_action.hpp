@@ -51,6 +51,26 @@ T action_sum(const P& problem, const NodeBlock<P, T>& b, int first, int last, do
   return S;
 }
 
+// Increment g~ = W A(p0, p1) over nodes (p0, p1) when its right end (node_at_right) or its left
+// end moves by (δp, η): W exp(η) A(p0, p1 + δp), or exp(-η) W A(p0 + δp, p1) (file comment).
+template <class P, class T>
+GroupElement<P, T> perturbed_increment(const P& problem, const GroupElement<P, T>& g, const Vec<T, P::shape_dim>& p0,
+                                       const Vec<T, P::shape_dim>& p1, const Vec<T, P::shape_dim>& dp,
+                                       const typename P::Group::template Tangent<T>& eta, bool node_at_right) {
+  using G = typename P::Group;
+  auto W = g;
+  if constexpr (has_connection<P>()) W = G::compose(W, G::inverse(connection(problem, p0, p1)));
+  if (node_at_right) {
+    W = G::compose(W, G::template exp<T>(eta));
+    if constexpr (has_connection<P>()) W = G::compose(W, connection(problem, p0, Vec<T, P::shape_dim>(p1 + dp)));
+  } else {
+    const typename G::template Tangent<T> minus_eta = -eta;
+    W = G::compose(G::template exp<T>(minus_eta), W);
+    if constexpr (has_connection<P>()) W = G::compose(W, connection(problem, Vec<T, P::shape_dim>(p0 + dp), p1));
+  }
+  return W;
+}
+
 // The block lifted to Dual<TO, r + d> with node c perturbed by (δp, η) in those directions
 // (the increments in windows first..last move; see the file comment).
 template <class P, class TO>
@@ -66,25 +86,11 @@ NodeBlock<P, Dual<TO, Dims<P>::node>> perturbed_node_block(const P& problem, con
   typename G::template Tangent<TI> eta;
   for (int i = 0; i < D::d; ++i) eta(i) = TI::variable(TO(0.0), D::r + i);
 
-  const Vec<TI, D::r> pc = b.p[c] + dp;
-  if (first <= c - 1) {  // g~_{c-1} is in a window
-    auto W = b.g[c - 1];
-    if constexpr (has_connection<P>())
-      W = G::compose(W, G::inverse(connection(problem, b.p[c - 1], b.p[c])));
-    b.g[c - 1] = G::compose(W, G::template exp<TI>(eta));
-    if constexpr (has_connection<P>())
-      b.g[c - 1] = G::compose(b.g[c - 1], connection(problem, b.p[c - 1], pc));
-  }
-  if (last >= c - D::k + 1 && c < 2 * D::k) {  // g~_c is in a window
-    auto W = b.g[c];
-    if constexpr (has_connection<P>())
-      W = G::compose(W, G::inverse(connection(problem, b.p[c], b.p[c + 1])));
-    const typename G::template Tangent<TI> minus_eta = -eta;
-    b.g[c] = G::compose(G::template exp<TI>(minus_eta), W);
-    if constexpr (has_connection<P>())
-      b.g[c] = G::compose(b.g[c], connection(problem, pc, b.p[c + 1]));
-  }
-  b.p[c] = pc;
+  if (first <= c - 1)  // g~_{c-1} is in a window
+    b.g[c - 1] = perturbed_increment(problem, b.g[c - 1], b.p[c - 1], b.p[c], dp, eta, true);
+  if (last >= c - D::k + 1 && c < 2 * D::k)  // g~_c is in a window
+    b.g[c] = perturbed_increment(problem, b.g[c], b.p[c], b.p[c + 1], dp, eta, false);
+  b.p[c] = b.p[c] + dp;
   return b;
 }
 

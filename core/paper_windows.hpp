@@ -25,6 +25,8 @@
 #pragma once
 
 #include "continuous.hpp"
+#include "group_element_scalars.hpp"
+#include "hessian_scalar.hpp"
 #include "problem.hpp"
 
 namespace lpshoot {
@@ -75,6 +77,27 @@ struct PaperWindows {
   template <class T>
   Vec<T, Group::dim> reduced_velocity(const Vec<T, shape_dim>& p0, const Vec<T, shape_dim>& p1, const Vec<T, shape_dim>& dp,
                                       const typename Group::template Element<T>& g, double h) const {
+    constexpr int r = shape_dim;
+    if constexpr (detail::is_hess<T>::value && has_element_scalars<Group>()) {
+      // A window's Hessian (step_window_hessian.hpp): ω depends on its 3r + s arguments only (s
+      // the element's scalars), so its group operations run in Hess<3r + s> and are composed.
+      constexpr int N = detail::is_hess<T>::width, s = ElementScalars<Group>::count, M = 3 * r + s;
+      if constexpr (M < N) {
+        auto gc = g;
+        const auto gs = ElementScalars<Group>::of(gc);
+        std::array<const T*, M> x;
+        for (int c = 0; c < r; ++c) x[c] = &p0(c), x[r + c] = &p1(c), x[2 * r + c] = &dp(c);
+        for (int c = 0; c < s; ++c) x[3 * r + c] = gs[c];
+        return detail::compose_through<N, M, Group::dim>(x, [&](const std::array<Hess<M>, M>& y) {
+          Vec<Hess<M>, r> q0, q1, dq;
+          for (int c = 0; c < r; ++c) q0(c) = y[c], q1(c) = y[r + c], dq(c) = y[2 * r + c];
+          auto gm = Group::template identity<Hess<M>>();
+          const auto gms = ElementScalars<Group>::of(gm);
+          for (int c = 0; c < s; ++c) *gms[c] = y[3 * r + c];
+          return reduced_velocity<Hess<M>>(q0, q1, dq, gm, h);
+        });
+      }
+    }
     if constexpr (detail::HasConnectionForm<C, T>::value) {
       const Vec<T, Group::dim> a = connection_velocity(model, Vec<T, shape_dim>(0.5 * (p0 + p1)), dp);
       const auto W = Group::compose(g, Group::inverse(Group::template exp<T>(a)));

@@ -9,6 +9,7 @@
 
 #include "local_action.hpp"
 #include "newton.hpp"
+#include "step_window_hessian.hpp"
 
 #include <stdexcept>
 #include <string>
@@ -133,46 +134,55 @@ void evaluate_step(const P& problem, double h, const FlowState<P>& s, const Step
   }
 }
 
+// Window j's coordinate w (nodes, increments, λ: window_coordinates) -> its column in the step's
+// (z, state) matrix: the unknowns first, then the state's tangent coordinates (FlowState).
+template <class P>
+int step_column(int j, int w) {
+  using D = Dims<P>;
+  using FS = FlowState<P>;
+  constexpr int k = D::k, r = D::r, d = D::d, nz = D::unknowns;
+  if (w < (k + 1) * r) {
+    const int i = j + w / r, a = w % r;
+    return i < 2 * k ? nz + FS::p_offset(i) + a : a;
+  }
+  w -= (k + 1) * r;
+  if (w < k * d) {
+    const int i = j + w / d, a = w % d;
+    return i < 2 * k - 1 ? nz + FS::g_offset(i) + a : r + a;
+  }
+  w -= k * d;
+  return j < k ? nz + FS::lam_offset(j) + w : r + d + w;
+}
+
 // F and its derivatives in the unknowns and the state's tangent coordinates (nz + state columns),
 // one window at a time: E_n = Σ_j ∂L~(a_j)/∂(node n) over windows j = n-k .. n, and window a_j
 // depends only on its own nodes, increments and λ^j ((k+1) r + k d + m coordinates, issue 9).
-// Each window is differentiated in those directions only and its columns are placed in J: about
-// half the work of one pass in all nz + state directions. Same numbers as evaluate_step with
-// with_state, to roundoff.
+// Each window is differentiated in those directions only and its columns are placed in J. Same
+// numbers as evaluate_step with with_state, to roundoff; the reference for the window Hessians'
+// path (step_window_hessian.hpp), and the path for windows too wide for it.
 template <class P>
 void evaluate_step_by_window(const P& problem, double h, const FlowState<P>& s, const StepUnknowns<P>& z,
                              Vec<double, Dims<P>::unknowns>& F,
                              Eigen::Matrix<double, Dims<P>::unknowns, Dims<P>::unknowns + Dims<P>::state>& J) {
   using D = Dims<P>;
   using G = typename P::Group;
-  using FS = FlowState<P>;
   constexpr int k = D::k, r = D::r, d = D::d, m = D::m, nz = D::unknowns;
-  constexpr int nw = (k + 1) * r + k * d + m;  // one window's coordinates
+  constexpr int nw = window_coordinates<P>();
   using T = Dual<double, nw>;
   const NodeBlock<P, double> b0 = step_block<P, double>(s, z, false);
   F.setZero();
   J.setZero();
   for (int j = 0; j <= k; ++j) {
     NodeBlock<P, T> b = lift<T>(b0);
-    std::array<int, nw> column;  // window coordinate -> column of J
     int w = 0;
     for (int i = j; i <= j + k; ++i)
-      for (int a = 0; a < r; ++a, ++w) {
-        b.p[i](a) = T::variable(b0.p[i](a), w);
-        column[w] = i < 2 * k ? nz + FS::p_offset(i) + a : a;
-      }
+      for (int a = 0; a < r; ++a, ++w) b.p[i](a) = T::variable(b0.p[i](a), w);
     for (int i = j; i < j + k; ++i) {
       typename G::template Tangent<T> delta;
-      for (int a = 0; a < d; ++a, ++w) {
-        delta(a) = T::variable(0.0, w);
-        column[w] = i < 2 * k - 1 ? nz + FS::g_offset(i) + a : r + a;
-      }
+      for (int a = 0; a < d; ++a, ++w) delta(a) = T::variable(0.0, w);
       b.g[i] = G::compose(b.g[i], G::template exp<T>(delta));
     }
-    for (int a = 0; a < m; ++a, ++w) {
-      b.lam[j](a) = T::variable(b0.lam[j](a), w);
-      column[w] = j < k ? nz + FS::lam_offset(j) + a : r + d + a;
-    }
+    for (int a = 0; a < m; ++a, ++w) b.lam[j](a) = T::variable(b0.lam[j](a), w);
     Vec<T, nz> Fj;
     Fj.template head<D::node>() = node_residual(problem, b, k, j, j, h);
     if constexpr (m > 0) {
@@ -181,9 +191,33 @@ void evaluate_step_by_window(const P& problem, double h, const FlowState<P>& s, 
     }
     for (int i = 0; i < nz; ++i) {
       F(i) += Fj(i).v;
-      for (int c = 0; c < nw; ++c) J(i, column[c]) += Fj(i).d[c];
+      for (int c = 0; c < nw; ++c) J(i, step_column<P>(j, c)) += Fj(i).d[c];
     }
   }
+}
+
+// ∂F/∂(z, state) from the windows' Hessians (step_window_hessian.hpp): window a_n's is computed
+// here, a_{n-k} .. a_{n-1}'s are taken from `carry` when it holds them (a flow's consecutive
+// steps: the same windows at the same points) and computed into it otherwise.
+template <class P>
+void step_jacobian_from_windows(const P& problem, double h, const FlowState<P>& s, const StepUnknowns<P>& z,
+                                WindowHessianCarry<P>& carry, long n,
+                                Eigen::Matrix<double, Dims<P>::unknowns, Dims<P>::unknowns + Dims<P>::state>& J) {
+  constexpr int k = P::order;
+  const NodeBlock<P, double> b0 = step_block<P, double>(s, z, false);
+  for (int j = 0; j <= k; ++j) {
+    const long index = n - k + j;
+    WindowHessian<P>& wh = carry.of(index);
+    if (j == k || wh.index != index) {
+      window_hessian(problem, b0.window(j), b0.lam[j], h, wh);
+      wh.index = index;
+    }
+  }
+  const auto& left = step_increment_perturbation(problem, b0, carry, n, false);
+  const auto& right = step_increment_perturbation(problem, b0, carry, n, true);
+  J.setZero();
+  node_derivatives_from_windows<P>([&](int j) -> const WindowHessian<P>& { return carry.of(n - k + j); }, left, right,
+                                   step_column<P>, true, J);
 }
 
 template <class P>
@@ -200,11 +234,14 @@ void apply_correction(StepUnknowns<P>& z, const Vec<double, Dims<P>::unknowns>& 
 }
 
 // Solves step n by Newton (newton.hpp) from the predictor (linear extrapolation of p, previous
-// increment and multiplier). The z-independent windows are evaluated once per step.
-// `chord`: a flow's factored step matrix, for chord iterations (newton_solve).
+// increment and multiplier). The z-independent windows are evaluated once per step, or, when
+// `carry` holds their gradients (a flow with sensitivities), their part of E_n is Σ Bᵀ g
+// (step_window_hessian.hpp). `chord`: a flow's factored step matrix, for chord iterations
+// (newton_solve).
 template <class P>
 StepReport solve_step(const P& problem, double h, const FlowState<P>& s, int n, const NewtonOptions& opt,
-                      StepUnknowns<P>& z, ChordMatrix<Dims<P>::unknowns>* chord = nullptr) {
+                      StepUnknowns<P>& z, ChordMatrix<Dims<P>::unknowns>* chord = nullptr,
+                      WindowHessianCarry<P>* carry = nullptr) {
   using D = Dims<P>;
   constexpr int k = D::k, nz = D::unknowns;
   if constexpr (keeps_low_parts<P>()) {
@@ -215,7 +252,15 @@ StepReport solve_step(const P& problem, double h, const FlowState<P>& s, int n, 
   }
   z.g = s.g[2 * k - 2];
   if constexpr (D::m > 0) z.lam = s.lam[k - 1];
-  const Vec<double, D::node> fixed = step_fixed_part(problem, h, s, z);
+  Vec<double, D::node> fixed;
+  if (carry && carry->holds(n - k, n - 1)) {
+    const NodeBlock<P, double> b = step_block<P, double>(s, z, false);
+    fixed = node_gradient_from_windows<P>([&](int j) -> const WindowHessian<P>& { return carry->of(n - k + j); }, 0,
+                                          k - 1, step_increment_perturbation(problem, b, *carry, n, false),
+                                          step_increment_perturbation(problem, b, *carry, n, true));
+  } else {
+    fixed = step_fixed_part(problem, h, s, z);
+  }
   if (!all_finite(fixed.data(), D::node)) {
     StepReport rep;
     rep.step = n;
@@ -240,22 +285,30 @@ StepReport solve_step(const P& problem, double h, const FlowState<P>& s, int n, 
       chord);
 }
 
-// dz/d(state) at a solved step (nz x state), by the implicit function theorem. Optionally the
+// dz/d(state) at a solved step n (nz x state), by the implicit function theorem. Optionally the
 // step matrix ∂F/∂z there, factored (for the next step's chord iterations), and its 1-norm
-// condition number (the regularity check at the solution).
+// condition number (the regularity check at the solution). `carry`: the flow's window Hessians
+// from its previous steps (step_jacobian_from_windows); without it every window is computed.
 template <class P>
 Eigen::Matrix<double, Dims<P>::unknowns, Dims<P>::state> step_sensitivity(
     const P& problem, double h, const FlowState<P>& s, const StepUnknowns<P>& z,
-    ChordMatrix<Dims<P>::unknowns>* chord = nullptr, double* condition = nullptr) {
+    ChordMatrix<Dims<P>::unknowns>* chord = nullptr, double* condition = nullptr,
+    WindowHessianCarry<P>* carry = nullptr, long n = P::order) {
   using D = Dims<P>;
   constexpr int nz = D::unknowns, ns = D::state;
-  Vec<double, nz> F;
   Eigen::Matrix<double, nz, nz + ns> J;
-  evaluate_step_by_window(problem, h, s, z, F, J);
+  if constexpr (uses_window_hessians<P>()) {
+    WindowHessianCarry<P> own;
+    step_jacobian_from_windows(problem, h, s, z, carry ? *carry : own, n, J);
+  } else {
+    (void)carry, (void)n;
+    Vec<double, nz> F;
+    evaluate_step_by_window(problem, h, s, z, F, J);
+  }
   const Eigen::Matrix<double, nz, nz> Jz = J.template leftCols<nz>();
   const Eigen::Matrix<double, nz, ns> Js = J.template rightCols<ns>();
-  ChordMatrix<nz> own;
-  ChordMatrix<nz>& factored = chord ? *chord : own;
+  ChordMatrix<nz> own_chord;
+  ChordMatrix<nz>& factored = chord ? *chord : own_chord;
   const Eigen::Matrix<double, nz, ns> dz = implicit_sensitivity<nz, ns>(Jz, Js, factored);
   if (condition) *condition = factored.condition;
   return dz;

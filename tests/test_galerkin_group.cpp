@@ -8,6 +8,7 @@
 #include <lpshoot/problems/electron_bvp.hpp>
 
 #include "beanie_galerkin_start.hpp"
+#include "curved_model.hpp"
 #include "galerkin_group_checks.hpp"
 
 #include <gtest/gtest.h>
@@ -172,31 +173,7 @@ TEST(ConnectionJet, ConstantFormsTakeTheDoublePathOnlyWhenExact) {
 }
 
 namespace {
-// A model with every part of the jet nonlinear: a shape-dependent connection on SE(2) × SO(2),
-// a Lagrangian mixing p, p', p'', Ω and Ω', one constraint.
-struct CurvedModel {
-  using Group = Product<SE2, SO2>;
-  static constexpr int shape_dim = 2;
-  static constexpr int num_constraints = 1;
-  template <class T>
-  T lagrangian(const Jet<CurvedModel, T>& q) const {
-    using std::cos, std::sin;
-    return 0.5 * q.ddp.squaredNorm() + cos(q.p(0)) * q.Omega.squaredNorm() + q.dOmega(0) * q.dp(1) +
-           0.3 * sin(q.Omega(2) * q.p(1)) + 0.2 * q.dOmega(3) * q.dOmega(1);
-  }
-  template <class T>
-  Vec<T, 1> constraints(const Jet<CurvedModel, T>& q) const {
-    using std::sin;
-    return Vec<T, 1>(q.Omega(3) - q.dp(0) * sin(q.p(1)) + q.dOmega(2) * q.Omega(0));
-  }
-  template <class T>
-  Eigen::Matrix<T, 4, 2> connection_form(const Vec<T, 2>& p) const {
-    using std::cos, std::sin;
-    Eigen::Matrix<T, 4, 2> A;
-    A << sin(p(0)), p(1) * p(1), T(0.3), cos(p(1)) * p(0), p(0) * p(0) * p(0), T(0.5), T(0.1) * p(1), T(-0.2);
-    return A;
-  }
-};
+using test_support::CurvedModel;
 
 // The chain rule through the jet inputs against Hess<ny> through everything: gradient and
 // Hessian (multiplier rows included) to roundoff. Dropping the μ term (the ends' curvature) or

@@ -1,0 +1,292 @@
+// The paper scheme's step derivatives from each window's Hessian, computed once and shared by
+// the k + 1 steps whose equations contain the window (issue 9; METHOD.md §2–§3).
+//
+// Step n's node equation is E_n = Σ_{j = n-k..n} ∂_ε L~(a_j after node n moves by ε = (δp, η))
+// (local_action.hpp). Window a_j's coordinates x are the state's tangent coordinates: nodes
+// p + δp, increments g~ exp(δ), multipliers λ + δλ. Let y(x, ε) be the window's coordinates after
+// the node perturbation, y(x, 0) = x. At the solved point, by the chain rule,
+//   ∂E_n/∂x = Bᵀ H + Σ_q g_q C_q,   B = ∂y/∂ε,  C_q = ∂²y_q/∂ε∂x,
+// with g and H the gradient and Hessian of L~(a_j) in x. g and H depend on the window alone: a_n's
+// are computed at step n (when its unknowns are solved) and reused at steps n+1 .. n+k. Only the
+// two increments next to node n move with ε (through the connection they also depend on their
+// ends), so B and C are two small nested-dual passes over group operations, shared by the
+// windows. χ_d(a_n)'s derivatives are H's λ rows: ∂²L~/∂λ∂x = ∂χ_d/∂x.
+// Per step: one pass in Hess arithmetic (hessian_scalar.hpp) instead of k + 1 nested-dual passes
+// of the windows in their nw directions (evaluate_step_by_window, kept as the reference).
+#pragma once
+
+#include "group_element_scalars.hpp"
+#include "hessian_scalar.hpp"
+#include "local_action.hpp"
+
+#include <array>
+
+namespace lpshoot {
+
+// A window's coordinates: its k+1 nodes (r each), k increments (d each), then λ (m).
+template <class P>
+constexpr int window_coordinates() {
+  return (P::order + 1) * P::shape_dim + P::order * P::Group::dim + P::num_constraints;
+}
+
+// Above this many coordinates a Hess scalar is too large for the stack to pay; the step's
+// derivatives are then taken window by window in nested duals.
+template <class P>
+constexpr bool uses_window_hessians() {
+  return window_coordinates<P>() <= 32;
+}
+
+// Gradient and Hessian of L~(a_index) in its coordinates; index -1 until computed.
+template <class P>
+struct WindowHessian {
+  static constexpr int size = window_coordinates<P>();
+  Vec<double, size> gradient;
+  Eigen::Matrix<double, size, size> hessian;
+  long index = -1;
+};
+
+// L_d and χ_d in Hess<nw - m> arithmetic (the window's nodes and increments); L~ = L_d + λ·χ_d is
+// linear in λ, so its λ rows are χ_d's gradient and its λλ block is zero.
+template <class P>
+void window_hessian(const P& problem, const Window<P, double>& a, const Vec<double, P::num_constraints>& lam, double h,
+                    WindowHessian<P>& out) {
+  using G = typename P::Group;
+  constexpr int k = P::order, r = P::shape_dim, d = G::dim, m = P::num_constraints, nw = window_coordinates<P>();
+  constexpr int nx = nw - m;
+  using T = Hess<nx>;
+  Window<P, T> A;
+  int w = 0;
+  for (int i = 0; i <= k; ++i)
+    for (int c = 0; c < r; ++c) A.p[i](c) = T::variable(a.p[i](c), w++);
+  A.p_low = a.p_low;
+  for (int i = 0; i < k; ++i, w += d) {
+    if constexpr (has_element_scalars<G>()) {
+      // g~ exp(δ) depends on δ alone: computed in Hess<d>, placed in its d directions.
+      using TD = Hess<d>;
+      typename G::template Tangent<TD> delta;
+      for (int c = 0; c < d; ++c) delta(c) = TD::variable(0.0, c);
+      auto moved = G::compose(G::template cast<TD>(a.g[i]), G::template exp<TD>(delta));
+      const auto from = ElementScalars<G>::of(moved);
+      const auto to = ElementScalars<G>::of(A.g[i]);
+      for (int c = 0; c < ElementScalars<G>::count; ++c) embed(*to[c], *from[c], w);
+    } else {
+      typename G::template Tangent<T> delta;
+      for (int c = 0; c < d; ++c) delta(c) = T::variable(0.0, w + c);
+      A.g[i] = G::compose(G::template cast<T>(a.g[i]), G::template exp<T>(delta));
+    }
+  }
+  auto add = [&](const T& f, double scale) {
+    for (int i = 0; i < nx; ++i) {
+      out.gradient(i) += scale * f.g[i];
+      for (int j = i; j < nx; ++j) out.hessian(i, j) += scale * f.H[T::at(i, j)];
+    }
+  };
+  out.gradient.setZero();
+  out.hessian.setZero();
+  add(problem.template lagrangian<T>(A, h), 1.0);
+  if constexpr (m > 0) {
+    const Vec<T, m> chi = problem.template constraints<T>(A, h);
+    for (int c = 0; c < m; ++c) {
+      add(chi(c), lam(c));
+      out.gradient(nx + c) = chi(c).v;
+      for (int i = 0; i < nx; ++i) out.hessian(i, nx + c) = chi(c).g[i];
+    }
+  }
+  out.hessian.template triangularView<Eigen::StrictlyLower>() = out.hessian.transpose();
+}
+
+// An increment g~ over (p0, p1) perturbed by a move ε = (δp, η) of its right end (node_at_right)
+// or left end, as y = log(g~^{-1} g~') in ε and in its own coordinates x = (δp0, δp1, δ):
+// B = ∂y/∂ε and C[q] = ∂²y_q/∂ε∂x at 0.
+template <class P>
+struct IncrementPerturbation {
+  static constexpr int r = P::shape_dim, d = P::Group::dim, node = r + d, own = 2 * r + d;
+  Eigen::Matrix<double, d, node> B;
+  std::array<Eigen::Matrix<double, node, own>, d> C;
+};
+
+// What a flow carries from step to step: the last k + 1 windows' Hessians (window a_i in slot
+// i mod (k + 1)), and step n's increment perturbations, computed by solve_step for its fixed part
+// and reused by step_sensitivity (both state-only: increment n-1, and n when k >= 2).
+template <class P>
+struct WindowHessianCarry {
+  std::array<WindowHessian<P>, P::order + 1> slot;
+  WindowHessian<P>& of(long index) { return slot[static_cast<size_t>(index % (P::order + 1))]; }
+  bool holds(long first, long last) {
+    for (long i = first; i <= last; ++i)
+      if (of(i).index != i) return false;
+    return true;
+  }
+  IncrementPerturbation<P> left, right;
+  long left_step = -1, right_step = -1;
+};
+
+// The group's structure constants as matrices: ad[b] w = [e_b, w] = d/dt Ad_{exp(t e_b)} w at 0.
+template <class G>
+const std::array<Eigen::Matrix<double, G::dim, G::dim>, G::dim>& lie_brackets() {
+  static const auto ad = [] {
+    constexpr int d = G::dim;
+    using T1 = Dual<double, 1>;
+    std::array<Eigen::Matrix<double, d, d>, d> out;
+    for (int b = 0; b < d; ++b) {
+      typename G::template Tangent<T1> t = G::template Tangent<T1>::Constant(T1(0.0));
+      t(b) = T1::variable(0.0, 0);
+      const Eigen::Matrix<T1, d, d> Ad = G::Ad(G::template exp<T1>(t));
+      for (int i = 0; i < d; ++i)
+        for (int j = 0; j < d; ++j) out[b](i, j) = Ad(i, j).d[0];
+    }
+    return out;
+  }();
+  return ad;
+}
+
+// B and C to first order in ε (local_action.hpp's perturbation, A = A(p0 + δp0, p1 + δp1)):
+//   right end: g~' = g~ exp(δ) A^{-1} exp(η) A(p0, p1 + δp)  =>  y = log(exp(δ) exp(v)),
+//              v = Ad_{A^{-1}} η + R δp;
+//   left end:  g~' = exp(-η) g~ exp(δ) A^{-1} A(p0 + δp, p1)  =>  y = log(exp(-u) exp(δ) exp(v)),
+//              u = Ad_{g~^{-1}} η, v = R δp;
+// R the moved end's right-trivialized connection derivative, R δp = log(A^{-1} A(.., end + δp)).
+// By Baker–Campbell–Hausdorff, y = δ + v − u + ½ [δ, v] + ½ [δ, u] + O(ε², δ² ε), so
+// B = ∂(v − u)/∂ε, C in δ is ½ [e_b, ∂(v ± u)/∂ε], and C in the ends is ∂²v/∂ε∂(δp0, δp1):
+// R's and Ad_{A^{-1}}'s first derivatives in the ends (a nested dual over the connection only).
+template <class P>
+IncrementPerturbation<P> increment_perturbation(const P& problem, const Vec<double, P::shape_dim>& p0,
+                                                const Vec<double, P::shape_dim>& p1, const GroupElement<P, double>& g,
+                                                bool node_at_right) {
+  using G = typename P::Group;
+  using IP = IncrementPerturbation<P>;
+  constexpr int r = IP::r, d = IP::d, node = IP::node, own = IP::own;
+  using TX = Dual<double, 2 * r>;  // the ends' δp0, δp1
+  Eigen::Matrix<TX, d, r> R;
+  Eigen::Matrix<TX, d, d> ad_inverse;  // Ad_{A^{-1}}
+  R.setConstant(TX(0.0));
+  ad_inverse.setConstant(TX(0.0));
+  for (int q = 0; q < d; ++q) ad_inverse(q, q) = TX(1.0);
+  if constexpr (has_connection<P>()) {
+    using TP = Dual<TX, r>;  // and the moved end's δp
+    Vec<TX, r> x0, x1;
+    Vec<TP, r> q0, q1, dp;
+    for (int c = 0; c < r; ++c) {
+      x0(c) = TX::variable(p0(c), c);
+      x1(c) = TX::variable(p1(c), r + c);
+      q0(c) = TP(x0(c));
+      q1(c) = TP(x1(c));
+      dp(c) = TP::variable(TX(0.0), c);
+    }
+    const GroupElement<P, TP> moved = node_at_right ? connection(problem, q0, Vec<TP, r>(q1 + dp))
+                                                    : connection(problem, Vec<TP, r>(q0 + dp), q1);
+    const typename G::template Tangent<TP> rel = G::log(G::compose(G::inverse(connection(problem, q0, q1)), moved));
+    for (int q = 0; q < d; ++q)
+      for (int c = 0; c < r; ++c) R(q, c) = rel(q).d[c];
+    if (node_at_right) ad_inverse = G::Ad(G::inverse(connection(problem, x0, x1)));
+  }
+  IP out;
+  for (int q = 0; q < d; ++q)
+    for (int e = 0; e < node; ++e) out.C[q].row(e).setZero();
+  for (int q = 0; q < d; ++q) {
+    for (int c = 0; c < r; ++c) {
+      out.B(q, c) = R(q, c).v;
+      for (int b = 0; b < 2 * r; ++b) out.C[q](c, b) = R(q, c).d[b];
+    }
+    for (int a = 0; a < d; ++a) {
+      if (node_at_right) {
+        out.B(q, r + a) = ad_inverse(q, a).v;
+        for (int b = 0; b < 2 * r; ++b) out.C[q](r + a, b) = ad_inverse(q, a).d[b];
+      }
+    }
+  }
+  Eigen::Matrix<double, d, d> sign = Eigen::Matrix<double, d, d>::Identity();
+  if (!node_at_right) {  // -u = -Ad_{g~^{-1}} η, and its bracket term has the opposite sign
+    out.B.template rightCols<d>() = -G::Ad(G::inverse(g));
+    sign = -sign;
+  }
+  const auto& ad = lie_brackets<G>();
+  for (int b = 0; b < d; ++b) {
+    Eigen::Matrix<double, d, node> bracket = 0.5 * ad[b] * out.B;
+    bracket.template rightCols<d>() = bracket.template rightCols<d>() * sign;
+    for (int q = 0; q < d; ++q) out.C[q].col(2 * r + b) = bracket.row(q).transpose();
+  }
+  (void)own;
+  return out;
+}
+
+// The perturbations of the block's two increments next to its node c = k (increment c-1 has
+// the node at its right, increment c at its left), from the carry when computed there for step
+// n, else computed (and kept when they depend on the state alone).
+template <class P>
+const IncrementPerturbation<P>& step_increment_perturbation(const P& problem, const NodeBlock<P, double>& b,
+                                                            WindowHessianCarry<P>& carry, long n, bool right) {
+  constexpr int c = P::order;
+  IncrementPerturbation<P>& ip = right ? carry.right : carry.left;
+  long& at = right ? carry.right_step : carry.left_step;
+  const bool state_only = !right || P::order >= 2;  // increment c = 2k - 1 is the step's unknown
+  if (!(state_only && at == n)) {
+    if constexpr (P::Group::dim > 0)
+      ip = right ? increment_perturbation(problem, b.p[c], b.p[c + 1], b.g[c], false)
+                 : increment_perturbation(problem, b.p[c - 1], b.p[c], b.g[c - 1], true);
+    at = state_only ? n : -1;
+  }
+  return ip;
+}
+
+// E_c's part from windows c-k+first .. c-k+last (c = k, the step's node): Σ_j Bᵀ g_j (the file
+// comment), from the windows' gradients.
+template <class P, class HessianOf>
+Vec<double, Dims<P>::node> node_gradient_from_windows(HessianOf&& hessian_of, int first, int last,
+                                                      const IncrementPerturbation<P>& left,
+                                                      const IncrementPerturbation<P>& right) {
+  constexpr int k = P::order, r = P::shape_dim, d = P::Group::dim, c = k;
+  Vec<double, Dims<P>::node> E = Vec<double, Dims<P>::node>::Zero();
+  for (int j = first; j <= last; ++j) {
+    const auto& g = hessian_of(j).gradient;
+    E.template head<r>() += g.template segment<r>((c - j) * r);
+    if constexpr (d > 0) {
+      if (j <= c - 1) E.noalias() += left.B.transpose() * g.template segment<d>((k + 1) * r + (c - 1 - j) * d);
+      if (j >= 1) E.noalias() += right.B.transpose() * g.template segment<d>((k + 1) * r + (c - j) * d);
+    }
+  }
+  return E;
+}
+
+// ∂E_c/∂x for node c = k of the block from windows 0 .. k, and, if with_constraints, ∂χ_d/∂x of
+// window k's in rows node..; columns placed by column(j, w) (window j's coordinate w). Each
+// window's Hessian comes from hessian_of(j); left and right as step_increment_perturbation's.
+template <class P, int Rows, int Cols, class HessianOf, class Column>
+void node_derivatives_from_windows(HessianOf&& hessian_of, const IncrementPerturbation<P>& left,
+                                   const IncrementPerturbation<P>& right, Column&& column, bool with_constraints,
+                                   Eigen::Matrix<double, Rows, Cols>& J) {
+  constexpr int k = P::order, r = P::shape_dim, d = P::Group::dim, m = P::num_constraints, node = r + d;
+  constexpr int nw = window_coordinates<P>(), c = k;
+  using IP = IncrementPerturbation<P>;
+  for (int j = 0; j <= k; ++j) {
+    const WindowHessian<P>& wh = hessian_of(j);
+    const auto& H = wh.hessian;
+    Eigen::Matrix<double, node, nw> dE = Eigen::Matrix<double, node, nw>::Zero();
+    dE.template topRows<r>() = H.template middleRows<r>((c - j) * r);  // node c's δp moves p only
+    if constexpr (d > 0) {
+      // Increment q of window j (its nodes q and q+1) moved by ε, with perturbation ip.
+      auto add_increment = [&](const IP& ip, int q) {
+        const int off = (k + 1) * r + q * d;
+        dE.noalias() += ip.B.transpose() * H.template middleRows<d>(off);
+        for (int a = 0; a < d; ++a) {
+          const double ga = wh.gradient(off + a);
+          dE.template middleCols<r>(q * r) += ga * ip.C[a].template leftCols<r>();
+          dE.template middleCols<r>((q + 1) * r) += ga * ip.C[a].template middleCols<r>(r);
+          dE.template middleCols<d>(off) += ga * ip.C[a].template rightCols<d>();
+        }
+      };
+      if (j <= c - 1) add_increment(left, c - 1 - j);
+      if (j >= 1) add_increment(right, c - j);
+    }
+    for (int w = 0; w < nw; ++w) {
+      const int col = column(j, w);
+      for (int i = 0; i < node; ++i) J(i, col) += dE(i, w);
+      if constexpr (m > 0) {
+        if (with_constraints && j == k)
+          for (int i = 0; i < m; ++i) J(node + i, col) += H(nw - m + i, w);
+      }
+    }
+  }
+}
+
+}  // namespace lpshoot
