@@ -155,7 +155,7 @@ IncrementPerturbation<P> increment_perturbation(const P& problem, const Vec<doub
                                                 bool node_at_right) {
   using G = typename P::Group;
   using IP = IncrementPerturbation<P>;
-  constexpr int r = IP::r, d = IP::d, node = IP::node, own = IP::own;
+  constexpr int r = IP::r, d = IP::d, node = IP::node;
   using TX = Dual<double, 2 * r>;  // the ends' δp0, δp1
   Eigen::Matrix<TX, d, r> R;
   Eigen::Matrix<TX, d, d> ad_inverse;  // Ad_{A^{-1}}
@@ -181,8 +181,7 @@ IncrementPerturbation<P> increment_perturbation(const P& problem, const Vec<doub
     if (node_at_right) ad_inverse = G::Ad(G::inverse(connection(problem, x0, x1)));
   }
   IP out;
-  for (int q = 0; q < d; ++q)
-    for (int e = 0; e < node; ++e) out.C[q].row(e).setZero();
+  for (auto& Cq : out.C) Cq.setZero();
   for (int q = 0; q < d; ++q) {
     for (int c = 0; c < r; ++c) {
       out.B(q, c) = R(q, c).v;
@@ -206,7 +205,6 @@ IncrementPerturbation<P> increment_perturbation(const P& problem, const Vec<doub
     bracket.template rightCols<d>() = bracket.template rightCols<d>() * sign;
     for (int q = 0; q < d; ++q) out.C[q].col(2 * r + b) = bracket.row(q).transpose();
   }
-  (void)own;
   return out;
 }
 
@@ -219,7 +217,7 @@ const IncrementPerturbation<P>& step_increment_perturbation(const P& problem, co
   constexpr int c = P::order;
   IncrementPerturbation<P>& ip = right ? carry.right : carry.left;
   long& at = right ? carry.right_step : carry.left_step;
-  const bool state_only = !right || P::order >= 2;  // increment c = 2k - 1 is the step's unknown
+  const bool state_only = !right || P::order >= 2;  // for k = 1, increment c = 2k - 1 is the unknown
   if (!(state_only && at == n)) {
     if constexpr (P::Group::dim > 0)
       ip = right ? increment_perturbation(problem, b.p[c], b.p[c + 1], b.g[c], false)
