@@ -273,7 +273,7 @@ IntervalDerivatives<Sch> group_interval_derivatives_chained(const typename Sch::
   for (int i = 0; i < Sch::gauss; ++i) {
     const double w = h * tab.b[i];
     const Eigen::Matrix<double, nu, ne>& A = maps.A[i];
-    const Vec<double, nu> u = A * ev + maps.B[i] * y;
+    const Vec<double, nu> u = A.lazyProduct(ev) + maps.B[i].lazyProduct(y);
     const Eigen::Matrix<double, nu, ny> Ju = maps.B[i] + A.lazyProduct(De);
     const Jet<typename Sch::Model, TU> q = seeded_jet<Sch>(model, u);
     TU phi = model.template lagrangian<TU>(q);
@@ -285,7 +285,7 @@ IntervalDerivatives<Sch> group_interval_derivatives_chained(const typename Sch::
         out.gradient(ny + k) = w * chi(c).v;
         Vec<double, nu> gc;
         for (int a = 0; a < nu; ++a) gc(a) = chi(c).g[a];
-        out.hessian.col(ny + k).template head<ny>().noalias() = w * (Ju.transpose() * gc);
+        out.hessian.col(ny + k).template head<ny>().noalias() = w * Ju.transpose().lazyProduct(gc);
         out.hessian.row(ny + k).template head<ny>() = out.hessian.col(ny + k).template head<ny>().transpose();
       }
     }
@@ -295,10 +295,10 @@ IntervalDerivatives<Sch> group_interval_derivatives_chained(const typename Sch::
       g(a) = phi.g[a];
       for (int b = a; b < nu; ++b) Hu(a, b) = Hu(b, a) = phi.H[TU::at(a, b)];
     }
-    out.gradient.template head<ny>().noalias() += w * (Ju.transpose() * g);
+    out.gradient.template head<ny>().noalias() += w * Ju.transpose().lazyProduct(g);
     const Eigen::Matrix<double, nu, ny> HJ = Hu.lazyProduct(Ju);
     H.noalias() += w * Ju.transpose().lazyProduct(HJ);
-    mu.noalias() += w * (A.transpose() * g);
+    mu.noalias() += w * A.transpose().lazyProduct(g);
   }
   // + Σ_j μ_j ∇²e_j (packed upper triangles, the first ny_e coordinates); the upper triangle
   // is the result, mirrored.
@@ -318,9 +318,12 @@ IntervalDerivatives<Sch> group_interval_derivatives_chained(const typename Sch::
 // L~'s derivatives: by the chain rule where the jet has fewer inputs than the interval has
 // coordinates, directly otherwise.
 template <class Sch>
+constexpr bool chains_interval_derivatives = 3 * Sch::r + 3 * Sch::d < IntervalDerivatives<Sch>::ny;
+
+template <class Sch>
 IntervalDerivatives<Sch> group_interval_derivatives(const typename Sch::Model& model, const Interval<Sch, double>& iv,
                                                     double h) {
-  if constexpr (3 * Sch::r + 3 * Sch::d < IntervalDerivatives<Sch>::ny)
+  if constexpr (chains_interval_derivatives<Sch>)
     return group_interval_derivatives_chained<Sch>(model, iv, h);
   else
     return group_interval_derivatives_direct<Sch>(model, iv, h);

@@ -11,6 +11,7 @@
 #include "galerkin.hpp"
 #include "galerkin_flat.hpp"
 #include "galerkin_group.hpp"
+#include "galerkin_group_gradient.hpp"
 #include "newton.hpp"
 
 namespace lpshoot {
@@ -215,6 +216,12 @@ Vec<double, Sch::unknowns> galerkin_step_residual(const typename Sch::Model& mod
     F = flat_right_rows<Sch>(g, h);
     F.template head<nv>() += fixed;
     if (right_gradient) *right_gradient = g;
+  } else if constexpr (chains_interval_derivatives<Sch>) {  // (∂L~/∂y, C) by the chain rule, mapped to the rows
+    (void)right_gradient;
+    using G = typename Sch::Group;
+    const Vec<double, IntervalDerivatives<Sch>::ne> g = group_interval_gradient_chained<Sch>(model, right, h);
+    F.noalias() = (1.0 / h) * group_right_map_times<Sch, 1>(h, G::Ad(G::inverse(right.W)), g);
+    F.template head<nv>() += fixed;
   } else {
     (void)right_gradient;
     Vec<double, nv> E;
@@ -239,6 +246,18 @@ void apply_galerkin_correction(Interval<Sch, double>& z, const Vec<double, Sch::
     z.W = G::compose(z.W, G::template exp<double>(step));
   }
   z.w += dz.template tail<Sch::aux>();
+}
+
+// |z_i| of the unknowns, for Newton's relative tolerance (0 for ζ: W's own size has no scale).
+template <class Sch>
+Vec<double, Sch::unknowns> unknowns_magnitude(const Interval<Sch, double>& z) {
+  constexpr int r = Sch::r, d = Sch::d;
+  Vec<double, Sch::unknowns> scale = Vec<double, Sch::unknowns>::Zero();
+  scale.template segment<r>(0) = z.X2.cwiseAbs();
+  scale.template segment<r>(r) = z.V1.cwiseAbs();
+  scale.template segment<d>(2 * r) = z.O1.cwiseAbs();
+  scale.template tail<Sch::aux>() = z.w.cwiseAbs();
+  return scale;
 }
 
 // Solves step n (interval n from interval n-1 = `state`) by Newton from the predictor "interval
@@ -307,14 +326,7 @@ StepReport solve_galerkin_step(const typename Sch::Model& model, double h, const
         apply_galerkin_correction<Sch>(z, dz, h);
         moved += dz;
       },
-      [&] {
-        Vec<double, nz> scale = Vec<double, nz>::Zero();
-        scale.template segment<r>(0) = z.X2.cwiseAbs();
-        scale.template segment<r>(r) = z.V1.cwiseAbs();
-        scale.template segment<d>(2 * r) = z.O1.cwiseAbs();
-        scale.template tail<Sch::aux>() = z.w.cwiseAbs();
-        return scale;
-      },
+      [&] { return unknowns_magnitude<Sch>(z); },
       chord, affine);
   if constexpr (d == 0) {
     if (affine && carry && carry->valid) {
@@ -327,14 +339,50 @@ StepReport solve_galerkin_step(const typename Sch::Model& model, double h, const
   return rep;
 }
 
+// Confirms a step that newton_solve ended on a prediction (StepReport::predicted), from the
+// evaluation at z its sensitivity made (F there and the exact step matrix, factored): the exact
+// Newton correction at z must be within predicted_step_allowance tolerances (newton.hpp), plus
+// the residual's noise as newton_solve allows at a stall. It is then applied (its error is O(correction²), below the
+// chord step's that it replaces) and interval n's carried gradient is moved with it to first
+// order: its Hessian times the correction and, with a group, (h/2) Bᵀ ζ from re-centring δ at
+// W exp(h ζ) (Baker–Campbell–Hausdorff, as galerkin_group.hpp's bracket terms). The next
+// step's E_n sees the corrected interval; the Hessian and the sensitivity stay those at z, off
+// by the correction, relatively. False: nothing is changed and the caller solves again from z.
+template <class Sch>
+bool confirm_predicted_step(double h, const NewtonOptions& opt, const Vec<double, Sch::unknowns>& F,
+                            const ChordMatrix<Sch::unknowns>& factored, Interval<Sch, double>& z, StepCarry<Sch>* carry) {
+  constexpr int r = Sch::r, d = Sch::d, nz = Sch::unknowns, ne = IntervalDerivatives<Sch>::ne;
+  static_assert(ne - Sch::X2_off == nz, "the unknowns are interval n's coordinates from X2 on");
+  const Vec<double, nz> correction = factored.lu.solve(-F);
+  const Vec<double, nz> scale = unknowns_magnitude<Sch>(z);
+  const double noise = std::min(1e-8, 64 * std::numeric_limits<double>::epsilon() * factored.condition);
+  if (!all_finite(correction.data(), nz) ||
+      !((correction.cwiseAbs().array() - (predicted_step_allowance * opt.step_tolerance + noise) * (1.0 + scale.array())) <=
+        0.0)
+           .all())
+    return false;
+  apply_galerkin_correction<Sch>(z, correction, h);
+  if (carry && carry->valid) {
+    Vec<double, ne> moved = carry->interval.hessian.template rightCols<nz>() * correction;
+    if constexpr (d > 0) {
+      const Eigen::Matrix<double, d, d> B =
+          bracket_form<typename Sch::Group>(carry->interval.gradient.template segment<d>(Sch::W_off));
+      moved.template segment<d>(Sch::W_off) += (0.5 * h) * (B.transpose() * correction.template segment<d>(2 * r + d));
+    }
+    carry->interval.gradient += moved;
+  }
+  return true;
+}
+
 // dz/d(state) at a solved step (nz x ns), by the implicit function theorem. Optionally the step
 // matrix ∂F/∂z there, factored (for the next step's chord iterations), and its 1-norm condition
 // number (the regularity check at the solution). `carry`: a flow's derivatives of the state from the step
-// before, updated to this step's (galerkin_flat.hpp).
+// before, updated to this step's (galerkin_flat.hpp). `residual`: F at z, from the same evaluation.
 template <class Sch>
 Eigen::Matrix<double, Sch::unknowns, Sch::state> galerkin_step_sensitivity(
     const typename Sch::Model& model, double h, const Interval<Sch, double>& state, const Interval<Sch, double>& z,
-    ChordMatrix<Sch::unknowns>* chord = nullptr, double* condition = nullptr, StepCarry<Sch>* carry = nullptr) {
+    ChordMatrix<Sch::unknowns>* chord = nullptr, double* condition = nullptr, StepCarry<Sch>* carry = nullptr,
+    Vec<double, Sch::unknowns>* residual = nullptr) {
   constexpr int nz = Sch::unknowns, ns = Sch::state;
   Vec<double, nz> F;
   Eigen::Matrix<double, nz, nz + ns> J;
@@ -345,6 +393,7 @@ Eigen::Matrix<double, Sch::unknowns, Sch::state> galerkin_step_sensitivity(
   ChordMatrix<nz>& factored = chord ? *chord : own;
   const Eigen::Matrix<double, nz, ns> dz = implicit_sensitivity<nz, ns>(Jz, Js, factored);
   if (condition) *condition = factored.condition;
+  if (residual) *residual = F;
   return dz;
 }
 

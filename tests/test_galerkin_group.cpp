@@ -177,13 +177,16 @@ using test_support::CurvedModel;
 
 // The chain rule through the jet inputs against Hess<ny> through everything: gradient and
 // Hessian (multiplier rows included) to roundoff. Dropping the μ term (the ends' curvature) or
-// a column of J_i shows as an O(1) relative difference.
+// a column of J_i shows as an O(1) relative difference. So does the gradient alone, the Newton
+// residuals' chain rule (galerkin_group_gradient.hpp), with a column of the ends' Jacobian dropped.
 template <class Sch>
 double chained_vs_direct(const typename Sch::Model& model, const Interval<Sch, double>& iv, double h) {
   const auto a = group_interval_derivatives_chained<Sch>(model, iv, h);
   const auto b = group_interval_derivatives_direct<Sch>(model, iv, h);
-  return std::max((a.gradient - b.gradient).cwiseAbs().maxCoeff() / b.gradient.cwiseAbs().maxCoeff(),
-                  (a.hessian - b.hessian).cwiseAbs().maxCoeff() / b.hessian.cwiseAbs().maxCoeff());
+  const auto g = group_interval_gradient_chained<Sch>(model, iv, h);
+  const double gs = b.gradient.cwiseAbs().maxCoeff();
+  return std::max({(a.gradient - b.gradient).cwiseAbs().maxCoeff() / gs, (g - b.gradient).cwiseAbs().maxCoeff() / gs,
+                   (a.hessian - b.hessian).cwiseAbs().maxCoeff() / b.hessian.cwiseAbs().maxCoeff()});
 }
 
 template <int S>
@@ -214,4 +217,52 @@ TEST(GalerkinGroupInterval, ChainRuleThroughTheJetInputsMatchesTheDirectHessian)
   }
   std::printf("interval derivatives, chain rule through the jet vs Hess<ny>: max relative difference %.2e\n", worst);
   EXPECT_LT(worst, 1e-13);
+}
+
+// A step whose chord iterations ended on a prediction is confirmed by one exact Newton
+// correction at z (confirm_predicted_step, what a flow with sensitivities does): the corrected
+// interval is the step's solution to O(ε²), and the carried gradient, moved to first order with
+// the bracket term of re-centring δ, is the fresh gradient there to O(ε²). Without that term it
+// is off by ~ (h/2) ε |∂L~/∂δ|; with the correction's sign flipped, by ε.
+TEST(GalerkinGroupStep, PredictedStepIsConfirmedByOneNewtonCorrection) {
+  using Sch = BeanieGalerkin<4>;
+  constexpr int nz = Sch::unknowns;
+  BeanieModel model;
+  model.par = {1.0, 1.0, 0.5, 1.0};
+  const double h = 0.5;
+  const auto state = test_support::beanie_interval_with_multipliers<4>(model, 2.0, 4);
+  Interval<Sch, double> solved;
+  const NewtonOptions opt;
+  ASSERT_EQ(solve_galerkin_step<Sch>(model, h, state, 1, opt, solved).status, StepStatus::Converged);
+  const double eps = 1e-5;
+  Vec<double, nz> off;
+  for (int i = 0; i < nz; ++i) off(i) = eps * std::cos(1.0 + 2 * i);
+  Interval<Sch, double> z = solved;
+  apply_galerkin_correction<Sch>(z, off, h);
+  StepCarry<Sch> carry;
+  carry.interval = group_interval_derivatives<Sch>(model, state, h);
+  carry.valid = true;
+  ChordMatrix<nz> chord;
+  double condition = 0;
+  Vec<double, nz> F;
+  galerkin_step_sensitivity<Sch>(model, h, state, z, &chord, &condition, &carry, &F);
+  // At the step's tolerance an ε-sized correction is refused, and nothing moves.
+  Interval<Sch, double> refused = z;
+  StepCarry<Sch> untouched = carry;
+  EXPECT_FALSE(confirm_predicted_step<Sch>(h, opt, F, chord, refused, &untouched));
+  EXPECT_EQ(untouched.interval.gradient, carry.interval.gradient);
+  NewtonOptions loose;
+  loose.step_tolerance = 1e-3;
+  ASSERT_TRUE(confirm_predicted_step<Sch>(h, loose, F, chord, z, &carry));
+  const auto fresh = group_interval_derivatives<Sch>(model, z, h);
+  const double gradient_error =
+      (carry.interval.gradient - fresh.gradient).cwiseAbs().maxCoeff() / fresh.gradient.cwiseAbs().maxCoeff();
+  const double group_error = SE2::log(SE2::compose(SE2::inverse(solved.W), z.W)).cwiseAbs().maxCoeff();
+  const double solution_error = std::max({(z.X2 - solved.X2).cwiseAbs().maxCoeff(), (z.V1 - solved.V1).cwiseAbs().maxCoeff(),
+                                          (z.O1 - solved.O1).cwiseAbs().maxCoeff(), (z.w - solved.w).cwiseAbs().maxCoeff(),
+                                          group_error});
+  std::printf("predicted step moved by %.0e: carried gradient off by %.2e, solution off by %.2e after one correction\n",
+              eps, gradient_error, solution_error);
+  EXPECT_LT(gradient_error, 1e-8);
+  EXPECT_LT(solution_error, 1e-8);
 }
