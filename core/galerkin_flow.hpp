@@ -6,6 +6,8 @@
 #include "degree.hpp"
 #include "galerkin_step.hpp"
 
+#include <Eigen/LU>
+
 #include <algorithm>
 #include <string>
 #include <vector>

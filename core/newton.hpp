@@ -11,9 +11,9 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <Eigen/LU>
 
 #include "one_norm_estimate.hpp"
+#include "small_lu.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -110,12 +110,11 @@ inline std::string format_number(double x) {
 // ||J||_1 times Hager's estimate of ||J^{-1}||_1 from the LU factors (one_norm_estimate.hpp): a
 // handful of solves instead of the inverse's n columns, which cost 6% of a beanie solve. inf or
 // NaN if J is singular (a zero pivot).
-template <class M, class LU>
-double condition_number_1(const M& J, const LU& lu) {
-  constexpr int n = M::RowsAtCompileTime;
+template <int n>
+double condition_number_1(const Eigen::Matrix<double, n, n>& J, const SmallLU<n>& lu) {
   using V = Eigen::Matrix<double, n, 1>;
   const double inverse_norm = inverse_one_norm_estimate<V>([&](const V& b) -> V { return lu.solve(b); },
-                                                           [&](const V& b) -> V { return lu.transpose().solve(b); }, n);
+                                                           [&](const V& b) -> V { return lu.solve_transposed(b); }, n);
   return J.cwiseAbs().colwise().sum().maxCoeff() * inverse_norm;
 }
 
@@ -138,7 +137,7 @@ inline std::string singular_step_reason(double condition, double max_condition) 
 // (bench/RESULTS.md, "Reusing Jacobians across steps and Newton iterations").
 template <int n>
 struct ChordMatrix {
-  Eigen::PartialPivLU<Eigen::Matrix<double, n, n>> lu;
+  SmallLU<n> lu;
   double condition = 0;  // 1-norm condition number of the factored matrix
   bool valid = false;
 };

@@ -5,6 +5,8 @@
 // against the exact condition number.
 #include <lpshoot/core/newton.hpp>
 
+#include <Eigen/LU>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -107,7 +109,7 @@ TEST(NewtonChord, AMatrixWhoseChordStepsDoNotContractIsRefreshed) {
   EXPECT_GE(s.jacobians, 1);
   EXPECT_LT(sys.F(s.z).lpNorm<Eigen::Infinity>(), 1e-11);
   // The carried matrix is now one evaluated here, near the solution (an iterate away from it).
-  const M3 carried = chord.lu.reconstructedMatrix();
+  const M3 carried = chord.lu.reconstructed();
   EXPECT_LT((carried - sys.J(s.z)).lpNorm<Eigen::Infinity>(), 0.02 * (sys.J(far) - sys.J(s.z)).lpNorm<Eigen::Infinity>());
 }
 
@@ -161,6 +163,64 @@ TEST(NewtonChord, ASingularMatrixIsReportedAndNotCarried) {
   EXPECT_LT(chord.condition, 1e3);
 }
 
+// The step matrices' LU (core/small_lu.hpp) against Eigen's PartialPivLU: the same pivots, so the
+// same factors to rounding, and solves (one column, 26 columns as a Galerkin 6 sensitivity, the
+// transpose) with backward errors at rounding, on random, nearly dependent and badly scaled
+// 21 x 21 matrices, and on a matrix whose first pivot is zero without an interchange.
+TEST(SmallLU, MatchesEigensPartialPivotingAndSolvesToRounding) {
+  using M = Eigen::Matrix<double, 21, 21>;
+  using V = Eigen::Matrix<double, 21, 1>;
+  using B = Eigen::Matrix<double, 21, 26>;
+  std::mt19937 rng(11);
+  std::normal_distribution<double> normal;
+  auto random = [&](auto& a) {
+    for (int i = 0; i < a.rows(); ++i)
+      for (int j = 0; j < a.cols(); ++j) a(i, j) = normal(rng);
+  };
+  double worst_factor = 0, worst_backward = 0;
+  for (int t = 0; t < 60; ++t) {
+    M J;
+    random(J);
+    if (t % 3 == 1) J.col(5) = J.col(3) + 1e-9 * J.col(5);
+    if (t % 3 == 2)
+      for (int i = 0; i < 21; ++i) J.row(i) *= std::pow(10.0, i % 7 - 3);
+    SmallLU<21> lu;
+    lu.compute(J);
+    const Eigen::PartialPivLU<M> eigen(J);
+    const double size = J.cwiseAbs().maxCoeff();
+    worst_factor = std::max(worst_factor, (lu.factors() - eigen.matrixLU()).cwiseAbs().maxCoeff() /
+                                              eigen.matrixLU().cwiseAbs().maxCoeff());
+    EXPECT_LT((lu.reconstructed() - J).cwiseAbs().maxCoeff(), 1e-13 * size) << t;
+    V b;
+    B bs;
+    random(b);
+    random(bs);
+    const double norm_j = J.cwiseAbs().rowwise().sum().maxCoeff();
+    const V x = lu.solve(b);
+    const B xs = lu.solve(bs);
+    const V y = lu.solve_transposed(b);
+    // Normwise backward errors |A x - b| / (|A| |x| + |b|), infinity norms.
+    auto backward = [&](const auto& r, const auto& x_, const auto& b_, double a) {
+      return r.cwiseAbs().maxCoeff() / (a * x_.cwiseAbs().maxCoeff() + b_.cwiseAbs().maxCoeff());
+    };
+    worst_backward = std::max({worst_backward, backward(J * x - b, x, b, norm_j),
+                               backward(J.transpose() * y - b, y, b, J.cwiseAbs().colwise().sum().maxCoeff())});
+    for (int c = 0; c < 26; ++c)
+      worst_backward = std::max(worst_backward, backward(J * xs.col(c) - bs.col(c), xs.col(c), bs.col(c), norm_j));
+  }
+  std::printf("small LU: factors against Eigen's %.1e, worst backward error %.1e\n", worst_factor, worst_backward);
+  EXPECT_LT(worst_factor, 1e-12);
+  EXPECT_LT(worst_backward, 1e-14);
+  // A zero leading entry: the first pivot is the second row.
+  Eigen::Matrix3d A;
+  A << 0, 2, 1, 3, 1, 0, 1, 1, 4;
+  SmallLU<3> lu3;
+  lu3.compute(A);
+  const Eigen::Vector3d b3(1, 2, 3);
+  EXPECT_LT((A * lu3.solve(b3) - b3).norm(), 1e-15 * 8);
+  EXPECT_LT((A.transpose() * lu3.solve_transposed(b3) - b3).norm(), 1e-15 * 8);
+}
+
 TEST(ConditionNumber, HagersEstimateIsALowerBoundWithinASmallFactorOfTheExact) {
   // The step matrices' regularity check (condition_number_1, LAPACK dgecon's estimator) against
   // ||J||_1 ||J^{-1}||_1 from the explicit inverse: random, nearly dependent and badly scaled
@@ -176,7 +236,8 @@ TEST(ConditionNumber, HagersEstimateIsALowerBoundWithinASmallFactorOfTheExact) {
     if (t % 3 == 1) J.col(5) = J.col(3) + 1e-9 * J.col(5);
     if (t % 3 == 2)
       for (int i = 0; i < 21; ++i) J.row(i) *= std::pow(10.0, i % 7 - 3);
-    const Eigen::PartialPivLU<M> lu(J);
+    SmallLU<21> lu;
+    lu.compute(J);
     const M inv = J.inverse();
     const double exact = J.cwiseAbs().colwise().sum().maxCoeff() * inv.cwiseAbs().colwise().sum().maxCoeff();
     const double estimate = condition_number_1(J, lu);
@@ -189,7 +250,8 @@ TEST(ConditionNumber, HagersEstimateIsALowerBoundWithinASmallFactorOfTheExact) {
   EXPECT_GT(largest, 1e8);  // the nearly dependent ones are in the sample
   M S = M::Identity();
   S.col(4).setZero();
-  const Eigen::PartialPivLU<M> lu(S);
+  SmallLU<21> lu;
+  lu.compute(S);
   EXPECT_FALSE(condition_number_1(S, lu) <= 1e13);  // singular: inf or NaN, never a number
 }
 

@@ -1,0 +1,98 @@
+// LU with partial pivoting (PA = LU, LAPACK getrf's row interchanges) of a small fixed-size
+// matrix, and the solves a step needs: one right-hand side, many, and with the transpose (Hager's
+// condition estimate). Eigen's PartialPivLU sends fixed sizes through its blocked kernels for
+// dynamic matrices (gebp, trsm, packing): at the Galerkin 6 beanie step (n = 21, 26 right-hand
+// sides) its factorization and many-column solve took 2.0 and 3.3 µs, these loops 1.5 and 1.7 µs
+// (bench/RESULTS.md, "Small step matrices"). Same pivots, results equal to rounding.
+// A zero pivot is kept (no division): solves then return inf or NaN, which the condition
+// estimate reports as a singular matrix (newton.hpp), as with Eigen's.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <array>
+#include <utility>
+
+namespace lpshoot {
+
+template <int n>
+class SmallLU {
+  static_assert(n > 0, "SmallLU is for fixed sizes");
+
+ public:
+  using Matrix = Eigen::Matrix<double, n, n>;
+  using Vector = Eigen::Matrix<double, n, 1>;
+
+  // Right-looking elimination on columns: each step is a pivot search, one row interchange and
+  // contiguous column updates below the pivot.
+  void compute(const Matrix& a) {
+    lu_ = a;
+    for (int k = 0; k < n; ++k) {
+      Eigen::Index p = 0;
+      lu_.col(k).tail(n - k).cwiseAbs().maxCoeff(&p);
+      pivot_[k] = k + static_cast<int>(p);
+      if (pivot_[k] != k) lu_.row(k).swap(lu_.row(pivot_[k]));
+      const int below = n - k - 1;
+      if (lu_(k, k) != 0) lu_.col(k).tail(below) /= lu_(k, k);
+      for (int j = k + 1; j < n; ++j) lu_.col(j).tail(below) -= lu_(k, j) * lu_.col(k).tail(below);
+    }
+  }
+
+  // A^{-1} b: the interchanges, then L (unit) and U by column updates.
+  Vector solve(const Vector& b) const {
+    Vector x = b;
+    for (int k = 0; k < n; ++k) std::swap(x(k), x(pivot_[k]));
+    for (int k = 0; k < n - 1; ++k) x.tail(n - k - 1) -= x(k) * lu_.col(k).tail(n - k - 1);
+    for (int k = n - 1; k >= 0; --k) {
+      x(k) /= lu_(k, k);
+      x.head(k) -= x(k) * lu_.col(k).head(k);
+    }
+    return x;
+  }
+
+  // A^{-1} B for m columns, on Bᵀ: row i of the solution is a combination of rows k < i (then
+  // k > i), each a contiguous vector of m, accumulated in place.
+  template <int m>
+  Eigen::Matrix<double, n, m> solve(const Eigen::Matrix<double, n, m>& b) const {
+    Eigen::Matrix<double, m, n> xt = b.transpose();
+    for (int k = 0; k < n; ++k)
+      if (pivot_[k] != k) xt.col(k).swap(xt.col(pivot_[k]));
+    for (int i = 1; i < n; ++i) {
+      Eigen::Matrix<double, m, 1> row = xt.col(i);
+      for (int k = 0; k < i; ++k) row -= lu_(i, k) * xt.col(k);
+      xt.col(i) = row;
+    }
+    for (int i = n - 1; i >= 0; --i) {
+      Eigen::Matrix<double, m, 1> row = xt.col(i);
+      for (int k = i + 1; k < n; ++k) row -= lu_(i, k) * xt.col(k);
+      xt.col(i) = row / lu_(i, i);
+    }
+    return xt.transpose();
+  }
+
+  // A^{-T} b = P^T L^{-T} U^{-T} b: dot products with the factors' columns.
+  Vector solve_transposed(const Vector& b) const {
+    Vector x = b;
+    for (int i = 0; i < n; ++i) x(i) = (x(i) - lu_.col(i).head(i).dot(x.head(i))) / lu_(i, i);
+    for (int i = n - 2; i >= 0; --i) x(i) -= lu_.col(i).tail(n - i - 1).dot(x.tail(n - i - 1));
+    for (int k = n - 1; k >= 0; --k) std::swap(x(k), x(pivot_[k]));
+    return x;
+  }
+
+  // L below the diagonal (unit diagonal implied) and U on and above it.
+  const Matrix& factors() const { return lu_; }
+
+  // P^T L U, the matrix factored (to rounding).
+  Matrix reconstructed() const {
+    Matrix a = lu_.template triangularView<Eigen::UnitLower>().toDenseMatrix() * lu_.template triangularView<Eigen::Upper>().toDenseMatrix();
+    for (int k = n - 1; k >= 0; --k)
+      if (pivot_[k] != k) a.row(k).swap(a.row(pivot_[k]));
+    return a;
+  }
+
+ private:
+  Matrix lu_ = Matrix::Zero();
+  std::array<int, n> pivot_{};  // row k was interchanged with row pivot_[k] >= k
+};
+
+}  // namespace lpshoot
