@@ -232,6 +232,20 @@ void interval_parts(const typename Sch::Model& model, const Interval<Sch, T>& iv
   }
 }
 
+// The integrand of L~ at Gauss point i with its multipliers, φ = ℓ(q) + Σ_c λ_{i,c} χ_c(q), and
+// χ(q) in `chi`: what the chain-rule derivatives of L~ differentiate (galerkin_group_gradient.hpp,
+// galerkin_group_interval.hpp).
+template <class Sch, class T>
+T multiplier_integrand(const typename Sch::Model& model, const Jet<typename Sch::Model, T>& q,
+                       const Interval<Sch, double>& iv, int i, Vec<T, Sch::m>& chi) {
+  T phi = model.template lagrangian<T>(q);
+  if constexpr (Sch::m > 0) {
+    chi = model.template constraints<T>(q);
+    for (int c = 0; c < Sch::m; ++c) add_scaled(phi, iv.w(Sch::multipliers(0) + i * Sch::m + c), chi(c));
+  }
+  return phi;
+}
+
 // L~ of one interval: h Σ_i b_i [ℓ(q_i) + λ_i · χ(q_i)].
 template <class Sch, class T>
 T interval_action(const typename Sch::Model& model, const Interval<Sch, T>& iv, double h) {

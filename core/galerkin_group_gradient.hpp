@@ -112,15 +112,9 @@ Vec<double, IntervalDerivatives<Sch>::ne> group_interval_gradient_chained(const 
       for (int c = 0; c < 3 * d; ++c) q.Omega(a).d[3 * r + c] = Om(a).d[c], q.dOmega(a).d[3 * r + c] = dOm(a).d[c];
     }
     add_connection_part<Sch, TU>(model, q);
-    TU phi = model.template lagrangian<TU>(q);
-    if constexpr (m > 0) {
-      const Vec<TU, m> chi = model.template constraints<TU>(q);
-      for (int c = 0; c < m; ++c) {
-        const int k = i * m + c;
-        add_scaled(phi, iv.w(Sch::multipliers(0) + k), chi(c));
-        out(ny + k) = w * chi(c).v;
-      }
-    }
+    Vec<TU, m> chi;
+    const TU phi = multiplier_integrand<Sch>(model, q, iv, i, chi);
+    for (int c = 0; c < m; ++c) out(ny + i * m + c) = w * chi(c).v;
     for (int a = 0; a < nu; ++a) gu(a) = w * phi.d[a];
     out.template head<ny>().noalias() += maps.B[i].transpose().lazyProduct(gu);
     mu.noalias() += maps.A[i].transpose().lazyProduct(gu);

@@ -276,12 +276,11 @@ IntervalDerivatives<Sch> group_interval_derivatives_chained(const typename Sch::
     const Vec<double, nu> u = A.lazyProduct(ev) + maps.B[i].lazyProduct(y);
     const Eigen::Matrix<double, nu, ny> Ju = maps.B[i] + A.lazyProduct(De);
     const Jet<typename Sch::Model, TU> q = seeded_jet<Sch>(model, u);
-    TU phi = model.template lagrangian<TU>(q);
+    Vec<TU, m> chi;
+    const TU phi = multiplier_integrand<Sch>(model, q, iv, i, chi);
     if constexpr (m > 0) {
-      const Vec<TU, m> chi = model.template constraints<TU>(q);
       for (int c = 0; c < m; ++c) {
         const int k = i * m + c;
-        add_scaled(phi, iv.w(Sch::multipliers(0) + k), chi(c));
         out.gradient(ny + k) = w * chi(c).v;
         Vec<double, nu> gc;
         for (int a = 0; a < nu; ++a) gc(a) = chi(c).g[a];
