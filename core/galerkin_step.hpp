@@ -260,6 +260,35 @@ Vec<double, Sch::unknowns> unknowns_magnitude(const Interval<Sch, double>& z) {
   return scale;
 }
 
+// Interval n's first iterate: interval n-1's unknowns on interval n's base node, or
+// `predictor` (unknowns' layout, ζ: W = W_{n-1} exp(h ζ)).
+template <class Sch>
+Interval<Sch, double> galerkin_step_start(const Interval<Sch, double>& state, double h,
+                                          const Vec<double, Sch::unknowns>* predictor) {
+  constexpr int r = Sch::r, d = Sch::d;
+  Interval<Sch, double> z = state;
+  const Interval<Sch, double> base = next_interval_base(state, h);
+  z.x = base.x, z.v = base.v, z.Om = base.Om;
+  if (predictor) {
+    z.X2 = predictor->template segment<r>(0);
+    z.V1 = predictor->template segment<r>(r);
+    if constexpr (d > 0) {
+      using G = typename Sch::Group;
+      z.O1 = predictor->template segment<d>(2 * r);
+      const typename G::template Tangent<double> step = h * predictor->template segment<d>(2 * r + d);
+      z.W = G::compose(state.W, G::template exp<double>(step));
+    }
+    z.w = predictor->template tail<Sch::aux>();
+  }
+  return z;
+}
+
+// max_i |dz_i| / (1 + |z_i|): a correction's size in the units of Newton's test.
+template <class Sch>
+double relative_size(const Vec<double, Sch::unknowns>& dz, const Interval<Sch, double>& z) {
+  return (dz.cwiseAbs().array() / (1.0 + unknowns_magnitude<Sch>(z).array())).maxCoeff();
+}
+
 // Solves step n (interval n from interval n-1 = `state`) by Newton from the predictor "interval
 // n-1's unknowns", or `predictor` (unknowns' layout, ζ: W = W_{n-1} exp(h ζ)); on return z is
 // interval n (its base node included).
@@ -276,20 +305,7 @@ StepReport solve_galerkin_step(const typename Sch::Model& model, double h, const
                                ChordMatrix<Sch::unknowns>* chord = nullptr, StepCarry<Sch>* carry = nullptr,
                                const Vec<double, Sch::unknowns>* predictor = nullptr, bool affine = false) {
   constexpr int r = Sch::r, d = Sch::d, nz = Sch::unknowns, nv = Sch::variation;
-  z = state;
-  const Interval<Sch, double> base = next_interval_base(state, h);
-  z.x = base.x, z.v = base.v, z.Om = base.Om;
-  if (predictor) {  // the unknowns' layout; ζ moves W from interval n-1's W
-    z.X2 = predictor->template segment<r>(0);
-    z.V1 = predictor->template segment<r>(r);
-    if constexpr (d > 0) {
-      using G = typename Sch::Group;
-      z.O1 = predictor->template segment<d>(2 * r);
-      const typename G::template Tangent<double> step = h * predictor->template segment<d>(2 * r + d);
-      z.W = G::compose(state.W, G::template exp<double>(step));
-    }
-    z.w = predictor->template tail<Sch::aux>();
-  }
+  z = galerkin_step_start<Sch>(state, h, predictor);
   Vec<double, nv> fixed;
   if constexpr (Sch::d == 0) {
     fixed = flat_left_rows<Sch>(carry && carry->valid ? carry->interval.gradient
@@ -339,6 +355,14 @@ StepReport solve_galerkin_step(const typename Sch::Model& model, double h, const
   return rep;
 }
 
+// How far, relative to 1 + |z_i|, the exact Newton correction that confirms a predicted step may
+// be: predicted_step_allowance tolerances (newton.hpp), plus the residual's noise as newton_solve
+// allows at a stall (64 u times the step matrix's condition, at most 1e-8).
+inline double predicted_step_bound(const NewtonOptions& opt, double condition) {
+  return predicted_step_allowance * opt.step_tolerance +
+         std::min(1e-8, 64 * std::numeric_limits<double>::epsilon() * condition);
+}
+
 // Confirms a step that newton_solve ended on a prediction (StepReport::predicted), from the
 // evaluation at z its sensitivity made (F there and the exact step matrix, factored): the exact
 // Newton correction at z must be within predicted_step_allowance tolerances (newton.hpp), plus
@@ -355,10 +379,8 @@ bool confirm_predicted_step(double h, const NewtonOptions& opt, const Vec<double
   static_assert(ne - Sch::X2_off == nz, "the unknowns are interval n's coordinates from X2 on");
   const Vec<double, nz> correction = factored.lu.solve(-F);
   const Vec<double, nz> scale = unknowns_magnitude<Sch>(z);
-  const double noise = std::min(1e-8, 64 * std::numeric_limits<double>::epsilon() * factored.condition);
   if (!all_finite(correction.data(), nz) ||
-      !((correction.cwiseAbs().array() - (predicted_step_allowance * opt.step_tolerance + noise) * (1.0 + scale.array())) <=
-        0.0)
+      !((correction.cwiseAbs().array() - predicted_step_bound(opt, factored.condition) * (1.0 + scale.array())) <= 0.0)
            .all())
     return false;
   apply_galerkin_correction<Sch>(z, correction, h);

@@ -34,6 +34,9 @@ struct StepReport {
   double condition = 0;  // 1-norm condition number of ∂F/∂z at the last evaluation
   // Converged by prediction (NewtonOptions::end_on_prediction): the caller must confirm it.
   bool predicted = false;
+  // When the step ended at its residual's noise (a correction that stopped shrinking, within the
+  // noise): that correction's relative size, a sample of the noise. 0 otherwise.
+  double noise_sample = 0;
   std::string message;   // empty when converged
 };
 
@@ -58,6 +61,9 @@ struct NewtonOptions {
   // that evaluate the step at z anyway and confirm there with an exact Newton correction: a
   // flow's step sensitivity (galerkin_flow.hpp, confirm_predicted_step).
   bool end_on_prediction = false;
+  // The relative size (|dz_i| / (1 + |z_i|), max over i) of corrections known to be the residual's
+  // noise, from earlier steps of the same flow (StepReport::noise_sample); 0: not known.
+  double noise_floor = 0;
 };
 
 // How far, in step tolerances, the exact Newton correction that confirms a predicted end may
@@ -231,6 +237,16 @@ StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian,
       rep.status = StepStatus::Converged;
       return rep;
     }
+    // A chord step that contracted 4-fold to within twice the flow's known noise, after which the
+    // next correction (ρ times this one) would be a quarter of the noise: further corrections
+    // would sample the noise, not reduce the error.
+    if (opt.noise_floor > 0 && !refresh && std::isfinite(last_step) && size <= 0.25 * last_step) {
+      const double relative = (dz.cwiseAbs().array() / (1.0 + scale.array())).maxCoeff();
+      if (relative <= 2 * opt.noise_floor && (size / last_step) * relative <= 0.25 * opt.noise_floor) {
+        rep.status = StepStatus::Converged;
+        return rep;
+      }
+    }
     if (opt.end_on_prediction && !refresh && std::isfinite(last_step) && size <= 0.25 * last_step) {
       const double rho = size / last_step;
       if (((rho * dz.cwiseAbs().array() - predicted_step_allowance * opt.step_tolerance * (1.0 + scale.array())) <= 0.0).all()) {
@@ -266,6 +282,7 @@ StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian,
                                        size > 0.25 * last_step;
     if (stalled) {
       if (within_noise(dz, scale)) {
+        rep.noise_sample = (dz.cwiseAbs().array() / (1.0 + scale.array())).maxCoeff();
         if (!refresh && !polish(size)) return fail(StepStatus::NonFinite, "the step equations evaluated to a non-finite number");
         rep.status = StepStatus::Converged;
         return rep;
