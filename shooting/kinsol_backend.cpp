@@ -277,9 +277,9 @@ struct Kinsol {
 // where exact Newton's last step leaves ~|e|²; the correction brings it there (boundary data such
 // as the beanie's θ(T) to 1e-12 at tolerance 1e-10, tests/test_galerkin.cpp). One sweep without
 // sensitivities; kept if the residual does not grow or stays within the tolerance. At the noise
-// the two residuals are samples of it, and a polished iterate left for the one before costs a
-// sweep to propagate that one's trajectory again (the beanie on Galerkin 4 at N = 10^5: 0.92
-// against 1.17 times the tolerance, one more sweep of seven).
+// the two residuals are samples of it, and a polished iterate dropped for the one before costs a
+// sweep to propagate that one's trajectory again (the beanie on Galerkin 4 at N = 10^5, both
+// within the tolerance: one sweep more, seven instead of six).
 void polish_after_chord(KinsolData& d, Kinsol& k) {
   Eigen::VectorXd F, F1;
   d.system->expect_jacobian(false);
