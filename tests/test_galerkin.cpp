@@ -170,5 +170,52 @@ void check_guided_flow() {
 TEST(GalerkinFlow, GuidedRunsLandOnTheSameSolutionInFewerIterations) { check_guided_flow<3>(); }
 TEST(GalerkinFlow, GuidedRunsLandOnTheSameSolutionInFewerIterationsWithBubbles) { check_guided_flow<4>(); }
 
+// A flow with sensitivities takes a step's prediction when the step before landed well within
+// the confirmation's bound of its own (galerkin_flow.hpp), and solves the step by Newton when
+// the exact correction at the prediction refuses it. Here the guide is a run from a start 1e-7
+// away, so its predictions are ~1e-14 off and steps 2 to 5 are taken, but its intervals from
+// step 5 on are corrupted (X2 by 1e-6, relative): step 5's prediction is refused and solved again
+// (seen with a counter in a patched copy). The run must land on the unguided run's solution and
+// sensitivity (measured: 2.2e-15 and 5.8e-15, sensitivities 2.9e-13 and 2.0e-13); a refused
+// prediction kept would leave step 5 ~1e-6 off.
+template <int S>
+void check_refused_prediction() {
+  using BG = BeanieGalerkin<S>;
+  BeanieModel model;
+  model.par = {1.0, 1.0, 0.5, 1.0};
+  const double h = 0.25;
+  const int steps = 7;
+  const auto start = beanie_interval_with_multipliers<S>(model, 2.0, 8);
+  const SE2::Element<double> g0{0.3, Eigen::Vector2d(0.5, -0.2)};
+  const GalerkinFlow<BG> flow(model, h);
+  constexpr int ns = BG::state, n = ns + BG::d;
+  const Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(n, n);
+  auto guide = flow.run(start, steps, &seed, g0, 0, true, nullptr, true);
+  ASSERT_TRUE(guide.report.ok()) << guide.report.message;
+  for (int k = 5; k <= steps; ++k) guide.trajectory.intervals[k].X2 *= 1.0 + 1e-6;
+  Vec<double, ns> delta;
+  for (int i = 0; i < ns; ++i) delta(i) = 1e-7 * std::sin(2.0 + i);
+  const auto moved = retract<BG>(start, delta, h);
+  const auto plain = flow.run(moved, steps, &seed, g0);
+  const auto guided = flow.run(moved, steps, &seed, g0, 0, true, &guide);
+  ASSERT_TRUE(plain.report.ok()) << plain.report.message;
+  ASSERT_TRUE(guided.report.ok()) << guided.report.message;
+  double worst = 0;
+  for (int k = 0; k <= steps; ++k)
+    worst = std::max(worst, state_difference(guided.trajectory.intervals[k], plain.trajectory.intervals[k], h)
+                                .template lpNorm<Eigen::Infinity>());
+  const double sens = (guided.sensitivity - plain.sensitivity).template lpNorm<Eigen::Infinity>() /
+                      plain.sensitivity.template lpNorm<Eigen::Infinity>();
+  std::printf("degree %d, a guide corrupted from step 5: Newton iterations %d guided, %d plain; solutions differ by "
+              "%.2e, sensitivities by %.2e\n",
+              S, guided.report.total_iterations, plain.report.total_iterations, worst, sens);
+  EXPECT_LT(worst, 1e-10);
+  EXPECT_LT(sens, 1e-8);
+  EXPECT_LT(2 * guided.report.total_iterations, plain.report.total_iterations);  // predictions were taken
+}
+
+TEST(GalerkinFlow, ARefusedPredictionIsSolvedByNewton) { check_refused_prediction<3>(); }
+TEST(GalerkinFlow, ARefusedPredictionIsSolvedByNewtonWithBubbles) { check_refused_prediction<4>(); }
+
 TEST(GalerkinShooting, JacobianMatchesFiniteDifferences) { check_shooting_jacobian<3>(); }
 TEST(GalerkinShooting, JacobianWithBubblesMatchesFiniteDifferences) { check_shooting_jacobian<4>(); }
