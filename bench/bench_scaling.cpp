@@ -4,8 +4,11 @@
 // the beanie on the cubic Galerkin scheme (tolerance 1e-10; V = 1 - cos ψ, the scene's data),
 // the electron (N <= 10^4) and the beanie (N <= 4000) on the paper's windows (second-order
 // closure) at tolerance 1e-6: finer grids fall below the nodal scheme's roundoff floor (~u/h^3).
-// Counters: converged, iterations, unknowns, and the peak resident memory of the process so far
-// (getrusage; a high-water mark, so read it on the largest N of a run).
+// The beanie at N >= 2 10^4 starts from a coarser grid's solution (the default,
+// ShootingOptions::coarse_start_from); BM_BeanieGalerkin4FromGuess solves it from the guess.
+// Counters: converged, iterations (on the grid itself; coarse_iterations on the coarser ones),
+// unknowns, and the peak resident memory of the process so far (getrusage; a high-water mark,
+// so read it on the largest N of a run).
 //   ./build/bench/bench_scaling --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
 #include <lpshoot/problems/beanie_bvp.hpp>
 #include <lpshoot/problems/electron_bvp.hpp>
@@ -24,8 +27,11 @@ constexpr double kT = 2.0;
 const ElectronBoundary kStart{Eigen::Vector3d(1.0, 0.0, 0.5), Eigen::Vector3d(0.0, 1.0, 0.0)};
 const ElectronBoundary kEnd{Eigen::Vector3d(0.0, 1.0, -0.5), Eigen::Vector3d(-1.0, 0.0, 0.2)};
 
-ShootingOptions options(int threads, double tolerance) {
+// from_guess: without the start from coarser grids (ShootingOptions::coarse_start_from = 0),
+// the comparison for the default's mesh sequencing on the beanie.
+ShootingOptions options(int threads, double tolerance, bool from_guess = false) {
   ShootingOptions opt;
+  if (from_guess) opt.coarse_start_from = 0;
   opt.method = ShootingMethod::Multiple;  // segments: auto
   opt.threads = threads;
   opt.solver.tolerance = tolerance;
@@ -44,15 +50,16 @@ void report(benchmark::State& state, const R& r) {
   state.counters["iterations"] = r.iterations;
   state.counters["unknowns"] = r.unknowns;
   state.counters["peak_MB"] = peak_rss_mb();
+  state.counters["coarse_iterations"] = r.coarse_iterations;
   if (!r.ok()) state.SetLabel(std::string(status_name(r.status)) + ": " + r.message);
 }
 
 // Times solve_bvp (problem and guess built outside the loop) and reports the last result.
 template <class BVP, class Guess>
-void timed_solves(benchmark::State& state, const BVP& bvp, const Guess& guess, double tolerance) {
+void timed_solves(benchmark::State& state, const BVP& bvp, const Guess& guess, double tolerance, bool from_guess = false) {
   decltype(solve_bvp(bvp, guess)) r;
   for (auto _ : state) {
-    r = solve_bvp(bvp, guess, options(static_cast<int>(state.range(1)), tolerance));
+    r = solve_bvp(bvp, guess, options(static_cast<int>(state.range(1)), tolerance, from_guess));
     benchmark::ClobberMemory();
   }
   report(state, r);
@@ -79,7 +86,7 @@ void beanie_data(BeanieBoundary& s, BeanieBoundary& e) {
   e.psi = 1.0, e.psi_dot = 0.0, e.theta = 1.0;
 }
 
-void beanie_galerkin(benchmark::State& state) {
+void beanie_galerkin_solve(benchmark::State& state, bool from_guess) {
   const int N = static_cast<int>(state.range(0));
   BeanieModel model;
   model.par = {1.0, 1.0, 0.5, 1.0};
@@ -87,8 +94,10 @@ void beanie_galerkin(benchmark::State& state) {
   beanie_data(s, e);
   const auto bvp = beanie_galerkin_bvp<3>(model, kT, N, s, e);
   const auto guess = beanie_galerkin_guess<3>(bvp, s, e);
-  timed_solves(state, bvp, guess, 1e-10);
+  timed_solves(state, bvp, guess, 1e-10, from_guess);
 }
+void beanie_galerkin(benchmark::State& state) { beanie_galerkin_solve(state, false); }
+void beanie_galerkin_from_guess(benchmark::State& state) { beanie_galerkin_solve(state, true); }
 
 void beanie_paper(benchmark::State& state) {
   const int N = static_cast<int>(state.range(0));
@@ -109,6 +118,9 @@ int main(int argc, char** argv) {
       benchmark::RegisterBenchmark("BM_ElectronGalerkin4", electron_galerkin)->Args({N, threads})->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
     for (int N : {1000, 10000, 100000, 1000000})
       benchmark::RegisterBenchmark("BM_BeanieGalerkin4", beanie_galerkin)->Args({N, threads})->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+    if (threads == 1)
+      for (int N : {100000, 1000000})
+        benchmark::RegisterBenchmark("BM_BeanieGalerkin4FromGuess", beanie_galerkin_from_guess)->Args({N, threads})->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
     for (int N : {1000, 3000, 10000})
       benchmark::RegisterBenchmark("BM_ElectronPaper", electron_paper)->Args({N, threads})->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
     for (int N : {1000, 2000, 4000})

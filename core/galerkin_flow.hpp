@@ -193,12 +193,6 @@ class GalerkinFlow {
         if (step.noise_sample > 0 && !seed) step_options.noise_floor = step.noise_sample;
       }
       if (!rep.add(step)) return out;
-      if (guided) {
-        const Vec<double, nz> solved = unknowns_relative_to(z, s);
-        const Vec<double, nz> other = extrapolated ? predicted : unknowns_relative_to(s, s);
-        guide_closer = (solved - from_guide).template lpNorm<Eigen::Infinity>() <=
-                       (solved - other).template lpNorm<Eigen::Infinity>();
-      }
       if (seed || affine_) {
         if (!dz_current) {
           Vec<double, nz> F_at_z;
@@ -239,6 +233,14 @@ class GalerkinFlow {
             mapped = true;
           }
         }
+      }
+      // Which prediction the solution lay closer to, decided once the step is solved: a taken
+      // step is known only after its confirmation (a refused one was solved again from there).
+      if (guided) {
+        const Vec<double, nz> solved = unknowns_relative_to(z, s);
+        const Vec<double, nz> other = extrapolated ? predicted : unknowns_relative_to(s, s);
+        guide_closer = (solved - from_guide).template lpNorm<Eigen::Infinity>() <=
+                       (solved - other).template lpNorm<Eigen::Infinity>();
       }
       if (seed) {
         const Eigen::MatrixXd& S = out.sensitivity;

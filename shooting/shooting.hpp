@@ -51,6 +51,10 @@ struct ShootingOptions {
   // Called as segments are propagated within one evaluation (segment done, of S): progress for
   // evaluations that take long (large N); may throw to stop the solve.
   std::function<void(int, int)> on_segment;
+  // Galerkin schemes: a solve on N >= coarse_start_from steps (and not affine) starts from the
+  // solution on N / coarse_ratio steps (coarse_start.hpp); 0: from the guess, whatever N.
+  int coarse_start_from = 20000;
+  int coarse_ratio = 100;
 };
 
 enum class ShootingStatus { Converged, NotConverged, RankDeficient, FlowFailed, InvalidProblem };
@@ -84,6 +88,10 @@ struct ShootingResult {
   bool stalled_at_floor = false;           // not converged: stalled at the flows' roundoff floor
   int segments = 0;                        // the segment count of this attempt (1: single shooting)
   std::vector<int> failed_segment_counts;  // earlier attempts with fewer segments (segment_doublings)
+  // A start from coarser grids (ShootingOptions::coarse_start_from): their N, coarsest first
+  // (empty: solved from the guess), and the Newton iterations spent on them.
+  std::vector<int> coarse_grids;
+  int coarse_iterations = 0;
   bool ok() const { return status == ShootingStatus::Converged; }
 };
 
@@ -338,10 +346,7 @@ ShootingResult<P> solve_bvp(const BoundaryValueProblem<P>& bvp, const ShootingGu
   return solve_bvp_with<P>(bvp, guess, opt);
 }
 
-template <class Sch>
-ShootingResult<Sch> solve_bvp(const GalerkinBVP<Sch>& bvp, const GalerkinGuess<Sch>& guess, const ShootingOptions& opt = {}) {
-  return solve_bvp_with<Sch>(bvp, guess, opt);
-}
+// solve_bvp for the Galerkin schemes, with its start from a coarser grid: coarse_start.hpp.
 
 inline const char* status_name(ShootingStatus s) {
   switch (s) {
@@ -355,3 +360,5 @@ inline const char* status_name(ShootingStatus s) {
 }
 
 }  // namespace lpshoot
+
+#include "coarse_start.hpp"  // solve_bvp for the Galerkin schemes

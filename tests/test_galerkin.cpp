@@ -113,6 +113,45 @@ void check_reused_step_matrices() {
 TEST(GalerkinFlow, ReusedStepMatricesLandOnTheSameSolution) { check_reused_step_matrices<3>(); }
 TEST(GalerkinFlow, ReusedStepMatricesLandOnTheSameSolutionWithBubbles) { check_reused_step_matrices<4>(); }
 
+// The guided-flow tests' setting: the beanie Galerkin flow with h = 0.25 over 7 steps from a
+// start with multipliers and g0, the identity seed (state and group), and a guide run from that
+// start with its memo recorded; `moved(eps)`: the start moved by eps sin(2 + i) in coordinate i.
+template <int S>
+struct GuidedFlowSetting {
+  using BG = BeanieGalerkin<S>;
+  static constexpr int steps = 7, ns = BG::state;
+  static constexpr double h = 0.25;
+  BeanieModel model = [] {
+    BeanieModel m;
+    m.par = {1.0, 1.0, 0.5, 1.0};
+    return m;
+  }();
+  Interval<BG, double> start = beanie_interval_with_multipliers<S>(model, 2.0, 8);
+  SE2::Element<double> g0{0.3, Eigen::Vector2d(0.5, -0.2)};
+  GalerkinFlow<BG> flow{model, h};
+  Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(ns + BG::d, ns + BG::d);
+  GalerkinFlowResult<BG> guide = flow.run(start, steps, &seed, g0, 0, true, nullptr, true);
+
+  Interval<BG, double> moved(double eps) const {
+    Vec<double, ns> delta;
+    for (int i = 0; i < ns; ++i) delta(i) = eps * std::sin(2.0 + i);
+    return retract<BG>(start, delta, h);
+  }
+  // The largest node-state difference between two runs of the steps, and the relative
+  // difference of their sensitivities.
+  static double solution_difference(const GalerkinFlowResult<BG>& a, const GalerkinFlowResult<BG>& b) {
+    double worst = 0;
+    for (int k = 0; k <= steps; ++k)
+      worst = std::max(worst, state_difference(a.trajectory.intervals[k], b.trajectory.intervals[k], h)
+                                  .template lpNorm<Eigen::Infinity>());
+    return worst;
+  }
+  static double sensitivity_difference(const GalerkinFlowResult<BG>& a, const GalerkinFlowResult<BG>& b) {
+    return (a.sensitivity - b.sensitivity).template lpNorm<Eigen::Infinity>() /
+           b.sensitivity.template lpNorm<Eigen::Infinity>();
+  }
+};
+
 // A run guided by an earlier run from a nearby start (GalerkinFlow::run's `guide`: step k starts
 // from the guide's interval k moved by the guide's dz times the change of interval k-1, with the
 // guide's step matrix) lands on the same solution as an unguided run, with the same sensitivity.
@@ -122,35 +161,19 @@ TEST(GalerkinFlow, ReusedStepMatricesLandOnTheSameSolutionWithBubbles) { check_r
 // O(1) is not guided: the same Newton iterations as without a guide.
 template <int S>
 void check_guided_flow() {
-  using BG = BeanieGalerkin<S>;
-  BeanieModel model;
-  model.par = {1.0, 1.0, 0.5, 1.0};
-  const double h = 0.25;
-  const int steps = 7;
-  const auto start = beanie_interval_with_multipliers<S>(model, 2.0, 8);
-  const SE2::Element<double> g0{0.3, Eigen::Vector2d(0.5, -0.2)};
-  const GalerkinFlow<BG> flow(model, h);
-  constexpr int ns = BG::state, n = ns + BG::d;
-  const Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(n, n);
-  const auto guide = flow.run(start, steps, &seed, g0, 0, true, nullptr, true);
-  ASSERT_TRUE(guide.report.ok()) << guide.report.message;
-  ASSERT_EQ(guide.memo.size(), static_cast<size_t>(steps));
+  const GuidedFlowSetting<S> set;
+  constexpr int steps = GuidedFlowSetting<S>::steps;
+  ASSERT_TRUE(set.guide.report.ok()) << set.guide.report.message;
+  ASSERT_EQ(set.guide.memo.size(), static_cast<size_t>(steps));
   for (const double eps : {1e-5, 1e-3, 0.5}) {
-    Vec<double, ns> delta;
-    for (int i = 0; i < ns; ++i) delta(i) = eps * std::sin(2.0 + i);
-    const auto moved = retract<BG>(start, delta, h);
-    for (const Eigen::MatrixXd* sd : {&seed, static_cast<const Eigen::MatrixXd*>(nullptr)}) {
-      const auto plain = flow.run(moved, steps, sd, g0);
-      const auto guided = flow.run(moved, steps, sd, g0, 0, true, &guide);
+    const auto moved = set.moved(eps);
+    for (const Eigen::MatrixXd* sd : {&set.seed, static_cast<const Eigen::MatrixXd*>(nullptr)}) {
+      const auto plain = set.flow.run(moved, steps, sd, set.g0);
+      const auto guided = set.flow.run(moved, steps, sd, set.g0, 0, true, &set.guide);
       ASSERT_TRUE(plain.report.ok()) << plain.report.message;
       ASSERT_TRUE(guided.report.ok()) << guided.report.message;
-      double worst = 0;
-      for (int k = 0; k <= steps; ++k)
-        worst = std::max(worst, state_difference(guided.trajectory.intervals[k], plain.trajectory.intervals[k], h)
-                                    .template lpNorm<Eigen::Infinity>());
-      const double sens = sd ? (guided.sensitivity - plain.sensitivity).template lpNorm<Eigen::Infinity>() /
-                                   plain.sensitivity.template lpNorm<Eigen::Infinity>()
-                             : 0.0;
+      const double worst = set.solution_difference(guided, plain);
+      const double sens = sd ? set.sensitivity_difference(guided, plain) : 0.0;
       std::printf("degree %d, start moved by %g, %s: Newton iterations %d guided, %d plain; solutions differ by %.2e, "
                   "sensitivities by %.2e\n",
                   S, eps, sd ? "seeded" : "plain", guided.report.total_iterations, plain.report.total_iterations, worst,
@@ -180,32 +203,17 @@ TEST(GalerkinFlow, GuidedRunsLandOnTheSameSolutionInFewerIterationsWithBubbles) 
 // prediction kept would leave step 5 ~1e-6 off.
 template <int S>
 void check_refused_prediction() {
-  using BG = BeanieGalerkin<S>;
-  BeanieModel model;
-  model.par = {1.0, 1.0, 0.5, 1.0};
-  const double h = 0.25;
-  const int steps = 7;
-  const auto start = beanie_interval_with_multipliers<S>(model, 2.0, 8);
-  const SE2::Element<double> g0{0.3, Eigen::Vector2d(0.5, -0.2)};
-  const GalerkinFlow<BG> flow(model, h);
-  constexpr int ns = BG::state, n = ns + BG::d;
-  const Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(n, n);
-  auto guide = flow.run(start, steps, &seed, g0, 0, true, nullptr, true);
-  ASSERT_TRUE(guide.report.ok()) << guide.report.message;
-  for (int k = 5; k <= steps; ++k) guide.trajectory.intervals[k].X2 *= 1.0 + 1e-6;
-  Vec<double, ns> delta;
-  for (int i = 0; i < ns; ++i) delta(i) = 1e-7 * std::sin(2.0 + i);
-  const auto moved = retract<BG>(start, delta, h);
-  const auto plain = flow.run(moved, steps, &seed, g0);
-  const auto guided = flow.run(moved, steps, &seed, g0, 0, true, &guide);
+  GuidedFlowSetting<S> set;
+  constexpr int steps = GuidedFlowSetting<S>::steps;
+  ASSERT_TRUE(set.guide.report.ok()) << set.guide.report.message;
+  for (int k = 5; k <= steps; ++k) set.guide.trajectory.intervals[k].X2 *= 1.0 + 1e-6;
+  const auto moved = set.moved(1e-7);
+  const auto plain = set.flow.run(moved, steps, &set.seed, set.g0);
+  const auto guided = set.flow.run(moved, steps, &set.seed, set.g0, 0, true, &set.guide);
   ASSERT_TRUE(plain.report.ok()) << plain.report.message;
   ASSERT_TRUE(guided.report.ok()) << guided.report.message;
-  double worst = 0;
-  for (int k = 0; k <= steps; ++k)
-    worst = std::max(worst, state_difference(guided.trajectory.intervals[k], plain.trajectory.intervals[k], h)
-                                .template lpNorm<Eigen::Infinity>());
-  const double sens = (guided.sensitivity - plain.sensitivity).template lpNorm<Eigen::Infinity>() /
-                      plain.sensitivity.template lpNorm<Eigen::Infinity>();
+  const double worst = set.solution_difference(guided, plain);
+  const double sens = set.sensitivity_difference(guided, plain);
   std::printf("degree %d, a guide corrupted from step 5: Newton iterations %d guided, %d plain; solutions differ by "
               "%.2e, sensitivities by %.2e\n",
               S, guided.report.total_iterations, plain.report.total_iterations, worst, sens);

@@ -217,9 +217,12 @@ TEST(NonlinearSolver, AStallJustAboveTheToleranceEndsWithoutALineSearch) {
   EXPECT_NE(out.status, SolverStatus::Converged);
   EXPECT_LT(out.residual_norm, 1e-8);
   EXPECT_NE(out.message.find("no line search"), std::string::npos) << out.message;
-  // At the noise two evaluations that do not halve the residual end the full steps (8 calls
-  // here); with the four allowed away from it, this run takes 10.
-  EXPECT_LE(f.calls, 8) << out.message;
+  std::printf("%d residual calls: %s\n", f.calls, out.message.c_str());
+  // At the noise one evaluation that does not halve the residual after an exact Newton step ends
+  // the full steps (kinsol_backend.cpp, stall_evaluations): 5 calls here, each further sample
+  // one more (two samples took 8 before the best iterate was recorded ahead of the stall test,
+  // the four allowed away from the noise 10).
+  EXPECT_LE(f.calls, 5) << out.message;
   EXPECT_TRUE(out.stalled_at_noise);
 }
 

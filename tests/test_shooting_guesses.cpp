@@ -255,3 +255,77 @@ TEST(ShootingGuesses, GalerkinWarmStartOfTheBeanieStartsCloseAndReachesTheSameSo
   for (int n = 0; n <= N; ++n) diff = std::max(diff, (cold.trajectory.x(n) - warm.trajectory.x(n)).cwiseAbs().maxCoeff());
   EXPECT_LT(diff, 1e-9);
 }
+
+// A Galerkin solve on a fine grid starts from coarser grids' solutions (ShootingOptions::
+// coarse_start_from, coarse_start.hpp): the beanie on Galerkin 6 at N = 2000 with the start from
+// N >= 400 and ratio 4 goes through N = 125 and 500. It must reach the solution the guess
+// reaches, starting far closer to it and in fewer iterations on the fine grid.
+TEST(CoarseStart, AFineGalerkinSolveStartsFromCoarserGridsAndReachesTheSameSolution) {
+  BeanieModel model;
+  model.par = {1.0, 1.0, 0.5, 1.0};
+  BeanieBoundary s = start_data(), e = end_data();
+  e.psi = 1.0;
+  ShootingOptions opt;
+  opt.method = ShootingMethod::Multiple;
+  opt.coarse_start_from = 400;
+  opt.coarse_ratio = 4;
+  ShootingOptions direct = opt;
+  direct.coarse_start_from = 0;
+  const int N = 2000;
+  const auto bvp = beanie_galerkin_bvp<4>(model, 2.0, N, s, e);
+  const auto guess = beanie_galerkin_guess<4>(bvp, s, e);
+  const auto warm = solve_bvp(bvp, guess, opt);
+  const auto cold = solve_bvp(bvp, guess, direct);
+  ASSERT_TRUE(warm.ok()) << warm.message;
+  ASSERT_TRUE(cold.ok()) << cold.message;
+  std::printf("initial residual: guess %.3g, from the coarser grids %.3g (x tolerance); iterations %d, %d (and %d on "
+              "the coarser grids)\n",
+              cold.residual_history.front(), warm.residual_history.front(), cold.iterations, warm.iterations,
+              warm.coarse_iterations);
+  EXPECT_EQ(warm.coarse_grids, (std::vector<int>{125, 500}));
+  EXPECT_TRUE(cold.coarse_grids.empty());
+  EXPECT_GT(warm.coarse_iterations, 0);
+  EXPECT_LT(warm.residual_history.front(), 1e-3 * cold.residual_history.front());
+  EXPECT_LT(warm.iterations, cold.iterations);
+  double diff = 0;
+  for (int n = 0; n <= N; ++n) diff = std::max(diff, (cold.trajectory.x(n) - warm.trajectory.x(n)).cwiseAbs().maxCoeff());
+  std::printf("solutions differ by %.2e\n", diff);
+  EXPECT_LT(diff, 1e-9);
+}
+
+// When the coarse grid cannot be solved, the fine grid is solved from the guess as without the
+// coarse start, and the detail says why. The beanie on Galerkin 6 with a stiff potential
+// (V = 100 (1 - cos ψ)): at N = 20 its flow fails from the guess (a step's Newton does not
+// converge), at N = 40 it converges; a start from N = 20 (ratio 2) falls back to the guess.
+TEST(CoarseStart, ACoarseGridThatFailsFallsBackToTheGuess) {
+  BeanieModel model;
+  model.par = {1.0, 1.0, 0.5, 100.0};
+  BeanieBoundary s = start_data(), e = end_data();
+  e.psi = 1.0;
+  ShootingOptions opt;
+  opt.method = ShootingMethod::Multiple;
+  opt.coarse_start_from = 40;
+  opt.coarse_ratio = 2;
+  ShootingOptions direct = opt;
+  direct.coarse_start_from = 0;
+  const auto bvp = beanie_galerkin_bvp<4>(model, 2.0, 40, s, e);
+  const auto guess = beanie_galerkin_guess<4>(bvp, s, e);
+  // The coarse solve as the fine one makes it: from the guess carried to N = 20.
+  const auto coarse_bvp = beanie_galerkin_bvp<4>(model, 2.0, 20, s, e);
+  const auto coarse =
+      solve_bvp(coarse_bvp, GalerkinGuess<BeanieGalerkin<4>>{resample_trajectory(model, guess.trajectory, 20)}, direct);
+  ASSERT_FALSE(coarse.ok()) << "the coarse grid was expected to fail here";
+  const auto fell_back = solve_bvp(bvp, guess, opt);
+  const auto from_guess = solve_bvp(bvp, guess, direct);
+  ASSERT_TRUE(from_guess.ok()) << from_guess.message;
+  ASSERT_TRUE(fell_back.ok()) << fell_back.message;
+  std::printf("detail: %s\n", fell_back.detail.c_str());
+  EXPECT_TRUE(fell_back.coarse_grids.empty());
+  EXPECT_EQ(fell_back.coarse_iterations, coarse.iterations);
+  EXPECT_NE(fell_back.detail.find("coarser grid failed (the solve on N = 20 first: "), std::string::npos) << fell_back.detail;
+  EXPECT_EQ(fell_back.iterations, from_guess.iterations);
+  double diff = 0;
+  for (int n = 0; n <= 40; ++n)
+    diff = std::max(diff, (fell_back.trajectory.x(n) - from_guess.trajectory.x(n)).cwiseAbs().maxCoeff());
+  EXPECT_EQ(diff, 0.0);  // the same solve from the same guess
+}

@@ -7,6 +7,10 @@
 #include <lpshoot/problems/beanie_bvp.hpp>
 #include <lpshoot/problems/electron_bvp.hpp>
 #include <lpshoot/shooting/band_lu.hpp>
+#include <lpshoot/shooting/banded_qr.hpp>
+
+#include <Eigen/OrderingMethods>
+#include <Eigen/SparseQR>
 
 #include <gtest/gtest.h>
 
@@ -236,6 +240,43 @@ TEST(StructuredDiagnosis, NearlyDependentRowsAgreeWithDenseOnBothSidesOfTheToler
     EXPECT_EQ(sparse.rank, delta < 1e-10 ? last : last + 1) << delta;
     EXPECT_EQ(sparse.dependent_conditions.size(), delta < 1e-10 ? 1u : 0u) << delta;
   }
+}
+
+// The banded QR's rank test (banded_qr.hpp, linear in n) takes the decision of Eigen's SparseQR
+// in natural order with the same threshold (the O(n²) factorization it stands in for), on either
+// side of the threshold: the last row moved off a combination of three others by delta (the
+// smallest singular value ~delta), a row made exactly dependent, and a matrix whose first column
+// is already triangular. A banded QR that always said "full rank" would miss the deficient ones;
+// one that never did would disagree on the others.
+TEST(StructuredDiagnosis, BandedQRDecidesTheRankAsSparseQR) {
+  using Sparse = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+  int deficient = 0, full = 0;
+  for (unsigned seed : {3u, 11u, 29u})
+    for (double delta : {0.0, 1e-13, 1e-11, 1e-9, 1e-7, 1e-2}) {
+      Eigen::MatrixXd J = block_bidiagonal(20, 6, 2, seed);
+      const int last = static_cast<int>(J.rows()) - 1;
+      J.row(last) = 0.5 * J.row(1) + J.row(10) - J.row(40);
+      J(last, 3) += delta;
+      const Sparse E = Sparse(equilibrated(J).sparseView());
+      const auto [kl, ku] = BandLU::bandwidths(E);
+      Eigen::SparseQR<Sparse, Eigen::NaturalOrdering<int>> qr;
+      qr.setPivotThreshold(1e-10);
+      qr.compute(E);
+      ASSERT_EQ(qr.info(), Eigen::Success);
+      const bool sparse_full = qr.rank() == E.cols();
+      EXPECT_EQ(banded_qr_full_rank(E, kl, ku, 1e-10), sparse_full) << "seed " << seed << ", delta " << delta;
+      (sparse_full ? full : deficient) += 1;
+    }
+  EXPECT_GT(deficient, 0);  // both sides were exercised
+  EXPECT_GT(full, 0);
+  // A first column with a single entry (no reflection) and a bandwidth too small for J.
+  Eigen::MatrixXd T = block_bidiagonal(4, 3, 1, 7);
+  T.col(0).setZero();
+  T(0, 0) = 2.0;
+  const Sparse S = Sparse(T.sparseView());
+  const auto [kl, ku] = BandLU::bandwidths(S);
+  EXPECT_TRUE(banded_qr_full_rank(S, kl, ku, 1e-10));
+  EXPECT_FALSE(banded_qr_full_rank(S, kl - 1, ku, 1e-10)) << "an entry outside the band given";
 }
 
 TEST(StructuredDiagnosis, NonFiniteEntriesHaveNoRank) {

@@ -33,6 +33,7 @@ json run_report(const Scene& scene, const RunRecord& r) {
     j["method"] = r.method;
     j["segments"] = r.segments;
     if (r.segments > 1) j["segment_starts"] = r.propagated_starts ? "forward sweep" : "guess";
+    if (!r.coarse_grids.empty()) j["coarse_start"] = {{"grids", r.coarse_grids}, {"iterations", r.coarse_iterations}};
     j["backend"] = r.backend;
     j["scheme"] = r.scheme;
     if (!r.closure.empty()) j["closure"] = r.closure;

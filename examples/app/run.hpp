@@ -41,6 +41,8 @@ struct RunRecord {
   std::string scheme;  // "paper" or "galerkin4" or "galerkin6" (Scene::scheme_name); empty for a simulation
   int segments = 1;
   bool propagated_starts = false;  // multiple shooting began from the forward sweep (SegmentStarts)
+  std::vector<int> coarse_grids;   // the solve started from these grids' solutions (ShootingOptions::coarse_start_from)
+  int coarse_iterations = 0;       // Newton iterations spent on them
   double tolerance = 0;
   bool has_cost = false;  // optimal control: ½ Σ h |u_n|^2
   double cost = 0;

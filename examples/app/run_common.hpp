@@ -111,6 +111,12 @@ void record_outcome(const ShootingResult<P>& res, RunRecord& r) {
                                 " (solver.segments \"auto\" doubles the segments when Newton does not converge)"
                           : " (with " + S + " segments; solver.segments \"auto\" tried " + counts + " first, see the detail)";
   }
+  if (res.ok() && !res.coarse_grids.empty()) {
+    std::string grids;
+    for (int n : res.coarse_grids) grids += (grids.empty() ? "" : ", ") + std::to_string(n);
+    r.message += ", from the solution on N = " + grids + " (" + std::to_string(res.coarse_iterations) +
+                 " iterations there; ShootingOptions::coarse_start_from)";
+  }
   if (res.ok() && res.propagated_starts)  // the scenes use SegmentStarts::Auto
     r.message += ", counting a failed attempt from the guess's segment starts before the forward sweep's";
   if (res.ok() && !r.continuation_path.empty())
@@ -119,6 +125,8 @@ void record_outcome(const ShootingResult<P>& res, RunRecord& r) {
                  std::to_string(r.continuation_solves) + " solves)";
   r.iterations = res.iterations;
   r.propagated_starts = res.propagated_starts;
+  r.coarse_grids = res.coarse_grids;
+  r.coarse_iterations = res.coarse_iterations;
   r.residual_norm = res.residual_norm;
   r.raw_residual_norm = res.raw_residual_norm;
   r.condition = res.condition;
