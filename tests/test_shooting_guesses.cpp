@@ -22,6 +22,23 @@ BeanieBoundary end_data() {
   e.psi = 2.5, e.psi_dot = 0.0, e.theta = 1.0;
   return e;
 }
+
+// The largest difference of the shape positions x_n between two Galerkin solutions on N steps.
+template <class R>
+double position_difference(const R& a, const R& b, int N) {
+  double diff = 0;
+  for (int n = 0; n <= N; ++n) diff = std::max(diff, (a.trajectory.x(n) - b.trajectory.x(n)).cwiseAbs().maxCoeff());
+  return diff;
+}
+
+// Multiple shooting with the start from coarser grids from N >= from at the given ratio.
+ShootingOptions coarse_start_options(int from, int ratio) {
+  ShootingOptions opt;
+  opt.method = ShootingMethod::Multiple;
+  opt.coarse_start_from = from;
+  opt.coarse_ratio = ratio;
+  return opt;
+}
 }  // namespace
 
 TEST(ShootingGuesses, WarmStartFromACoarserGridGivesTheSameSolution) {
@@ -251,9 +268,7 @@ TEST(ShootingGuesses, GalerkinWarmStartOfTheBeanieStartsCloseAndReachesTheSameSo
               cold.residual_history.front(), warm.residual_history.front(), cold.iterations, warm.iterations);
   EXPECT_LT(warm.residual_history.front(), 0.05 * cold.residual_history.front());
   EXPECT_LT(warm.iterations, cold.iterations);
-  double diff = 0;
-  for (int n = 0; n <= N; ++n) diff = std::max(diff, (cold.trajectory.x(n) - warm.trajectory.x(n)).cwiseAbs().maxCoeff());
-  EXPECT_LT(diff, 1e-9);
+  EXPECT_LT(position_difference(cold, warm, N), 1e-9);
 }
 
 // A Galerkin solve on a fine grid starts from coarser grids' solutions (ShootingOptions::
@@ -265,12 +280,7 @@ TEST(CoarseStart, AFineGalerkinSolveStartsFromCoarserGridsAndReachesTheSameSolut
   model.par = {1.0, 1.0, 0.5, 1.0};
   BeanieBoundary s = start_data(), e = end_data();
   e.psi = 1.0;
-  ShootingOptions opt;
-  opt.method = ShootingMethod::Multiple;
-  opt.coarse_start_from = 400;
-  opt.coarse_ratio = 4;
-  ShootingOptions direct = opt;
-  direct.coarse_start_from = 0;
+  const ShootingOptions opt = coarse_start_options(400, 4), direct = coarse_start_options(0, 4);
   const int N = 2000;
   const auto bvp = beanie_galerkin_bvp<4>(model, 2.0, N, s, e);
   const auto guess = beanie_galerkin_guess<4>(bvp, s, e);
@@ -287,8 +297,7 @@ TEST(CoarseStart, AFineGalerkinSolveStartsFromCoarserGridsAndReachesTheSameSolut
   EXPECT_GT(warm.coarse_iterations, 0);
   EXPECT_LT(warm.residual_history.front(), 1e-3 * cold.residual_history.front());
   EXPECT_LT(warm.iterations, cold.iterations);
-  double diff = 0;
-  for (int n = 0; n <= N; ++n) diff = std::max(diff, (cold.trajectory.x(n) - warm.trajectory.x(n)).cwiseAbs().maxCoeff());
+  const double diff = position_difference(cold, warm, N);
   std::printf("solutions differ by %.2e\n", diff);
   EXPECT_LT(diff, 1e-9);
 }
@@ -302,12 +311,7 @@ TEST(CoarseStart, ACoarseGridThatFailsFallsBackToTheGuess) {
   model.par = {1.0, 1.0, 0.5, 100.0};
   BeanieBoundary s = start_data(), e = end_data();
   e.psi = 1.0;
-  ShootingOptions opt;
-  opt.method = ShootingMethod::Multiple;
-  opt.coarse_start_from = 40;
-  opt.coarse_ratio = 2;
-  ShootingOptions direct = opt;
-  direct.coarse_start_from = 0;
+  const ShootingOptions opt = coarse_start_options(40, 2), direct = coarse_start_options(0, 2);
   const auto bvp = beanie_galerkin_bvp<4>(model, 2.0, 40, s, e);
   const auto guess = beanie_galerkin_guess<4>(bvp, s, e);
   // The coarse solve as the fine one makes it: from the guess carried to N = 20.
@@ -324,8 +328,5 @@ TEST(CoarseStart, ACoarseGridThatFailsFallsBackToTheGuess) {
   EXPECT_EQ(fell_back.coarse_iterations, coarse.iterations);
   EXPECT_NE(fell_back.detail.find("coarser grid failed (the solve on N = 20 first: "), std::string::npos) << fell_back.detail;
   EXPECT_EQ(fell_back.iterations, from_guess.iterations);
-  double diff = 0;
-  for (int n = 0; n <= 40; ++n)
-    diff = std::max(diff, (fell_back.trajectory.x(n) - from_guess.trajectory.x(n)).cwiseAbs().maxCoeff());
-  EXPECT_EQ(diff, 0.0);  // the same solve from the same guess
+  EXPECT_EQ(position_difference(fell_back, from_guess, 40), 0.0);  // the same solve from the same guess
 }
