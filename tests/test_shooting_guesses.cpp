@@ -31,6 +31,18 @@ double position_difference(const R& a, const R& b, int N) {
   return diff;
 }
 
+// The beanie with V = amplitude (1 - cos ψ), and the end data with ψ(T) = 1.
+BeanieModel beanie_model(double amplitude) {
+  BeanieModel model;
+  model.par = {1.0, 1.0, 0.5, amplitude};
+  return model;
+}
+BeanieBoundary end_at_psi_one() {
+  BeanieBoundary e = end_data();
+  e.psi = 1.0;
+  return e;
+}
+
 // Multiple shooting with the start from coarser grids from N >= from at the given ratio.
 ShootingOptions coarse_start_options(int from, int ratio) {
   ShootingOptions opt;
@@ -276,10 +288,8 @@ TEST(ShootingGuesses, GalerkinWarmStartOfTheBeanieStartsCloseAndReachesTheSameSo
 // N >= 400 and ratio 4 goes through N = 125 and 500. It must reach the solution the guess
 // reaches, starting far closer to it and in fewer iterations on the fine grid.
 TEST(CoarseStart, AFineGalerkinSolveStartsFromCoarserGridsAndReachesTheSameSolution) {
-  BeanieModel model;
-  model.par = {1.0, 1.0, 0.5, 1.0};
-  BeanieBoundary s = start_data(), e = end_data();
-  e.psi = 1.0;
+  const BeanieModel model = beanie_model(1.0);
+  const BeanieBoundary s = start_data(), e = end_at_psi_one();
   const ShootingOptions opt = coarse_start_options(400, 4), direct = coarse_start_options(0, 4);
   const int N = 2000;
   const auto bvp = beanie_galerkin_bvp<4>(model, 2.0, N, s, e);
@@ -307,10 +317,8 @@ TEST(CoarseStart, AFineGalerkinSolveStartsFromCoarserGridsAndReachesTheSameSolut
 // (V = 100 (1 - cos ψ)): at N = 20 its flow fails from the guess (a step's Newton does not
 // converge), at N = 40 it converges; a start from N = 20 (ratio 2) falls back to the guess.
 TEST(CoarseStart, ACoarseGridThatFailsFallsBackToTheGuess) {
-  BeanieModel model;
-  model.par = {1.0, 1.0, 0.5, 100.0};
-  BeanieBoundary s = start_data(), e = end_data();
-  e.psi = 1.0;
+  const BeanieModel model = beanie_model(100.0);
+  const BeanieBoundary s = start_data(), e = end_at_psi_one();
   const ShootingOptions opt = coarse_start_options(40, 2), direct = coarse_start_options(0, 2);
   const auto bvp = beanie_galerkin_bvp<4>(model, 2.0, 40, s, e);
   const auto guess = beanie_galerkin_guess<4>(bvp, s, e);
