@@ -74,7 +74,8 @@ BENCHMARK(BM_BeanieControlStep_EngineWithSensitivity);
 
 // As a flow's steps run it: windows a_{n-k} .. a_{n-1}'s Hessians carried from the previous
 // steps (step_window_hessian.hpp), a_n's computed; Newton starts with chord iterations on the
-// previous step's factored matrix (newton.hpp), here the same step's.
+// previous step's factored matrix (newton.hpp), here the same step's; the part of E_n from
+// a_{n-k} .. a_{n-1} comes from their carried gradients, as DiscreteFlow::run passes the carry.
 template <class P>
 static void step_as_in_a_flow(benchmark::State& st, const P& problem, const FlowState<P>& s, double h) {
   const NewtonOptions opt;
@@ -86,7 +87,7 @@ static void step_as_in_a_flow(benchmark::State& st, const P& problem, const Flow
   int iterations = 0;
   for (auto _ : st) {
     ChordMatrix<Dims<P>::unknowns> chord = previous;
-    iterations = solve_step(problem, h, s, 2, opt, z, &chord).iterations;
+    iterations = solve_step(problem, h, s, 2, opt, z, &chord, &carry).iterations;
     auto dz = step_sensitivity(problem, h, s, z, &chord, nullptr, &carry, 2);
     benchmark::DoNotOptimize(dz);
   }
@@ -98,6 +99,28 @@ static void BM_BeanieControlStep_EngineWithSensitivityAsInAFlow(benchmark::State
   step_as_in_a_flow(st, b, beanie_state(b, 0.01), 0.01);
 }
 BENCHMARK(BM_BeanieControlStep_EngineWithSensitivityAsInAFlow);
+
+// A flow with sensitivities (DiscreteFlow::run, all state directions seeded), per step: each
+// step's Newton starts on the previous step's matrix, whose chord steps contract as the matrix
+// changes from step to step (the loop above reuses the same step's: exact).
+static void BM_BeanieControlFlowWithSensitivity(benchmark::State& st) {
+  const BeanieControl b = beanie();
+  const double h = 0.01;
+  const int N = 200;
+  const DiscreteFlow<BeanieControl> flow(b, h);
+  const Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(Dims<BeanieControl>::state, Dims<BeanieControl>::state);
+  FlowReport report;
+  for (auto _ : st) {
+    auto out = flow.run(beanie_state(b, h), N, &seed);
+    report = out.report;
+    benchmark::DoNotOptimize(out.sensitivity);
+  }
+  if (!report.ok()) st.SkipWithError(report.message.c_str());
+  const int steps = N - 2 * BeanieControl::order + 1;
+  st.counters["per_step"] = benchmark::Counter(steps, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  st.counters["newton_per_step"] = double(report.total_iterations) / steps;
+}
+BENCHMARK(BM_BeanieControlFlowWithSensitivity);
 
 // The hand-written tangent-linear step (tests/oracles/analytic_steps.cpp): value and dz/d(state).
 static void BM_BeanieControlStep_AnalyticWithSensitivity(benchmark::State& st) {

@@ -155,14 +155,31 @@ class DiscreteFlow {
     double condition = 0;  // dz's step matrix's
     bool dz_current = false;
     WindowHessianCarry<P> windows;  // each window's Hessian, shared by the k + 1 steps it enters
+    // With sensitivities, each step's sensitivity evaluates window a_n at the solution anyway
+    // (its gradient gives F there): a predicted end of the chord steps (newton.hpp) saves the
+    // residual that would show it, and is confirmed there (confirm_predicted_step). Beanie
+    // control at h = 0.01: three residuals per step before, two now.
+    NewtonOptions step_options = options_;
+    step_options.end_on_prediction = seed && !affine_ && uses_window_hessians<P>();
     for (int n = k; n <= N - k; ++n) {
       StepUnknowns<P> z;
-      if (!rep.add(solve_step(problem_, h_, s, n, options_, z, chord_used, seed ? &windows : nullptr))) return out;
+      const StepReport step = solve_step(problem_, h_, s, n, step_options, z, chord_used, seed ? &windows : nullptr);
+      if (!rep.add(step)) return out;
       if (seed) {
         // New state = shifted old state + z; the new rows come from the implicit function theorem.
         if (!dz_current) {
           dz = step_sensitivity(problem_, h_, s, z, &chord, &condition, &windows, n);
           dz_current = affine_;
+          if (step.predicted && condition <= options_.max_condition &&
+              !confirm_predicted_step(problem_, options_, s, chord, windows, n, z)) {
+            // Not confirmed: Newton again from z, on the exact matrix just factored.
+            NewtonOptions again = step_options;
+            again.end_on_prediction = false;
+            const StepUnknowns<P> from = z;
+            --rep.steps;  // counted again by add
+            if (!rep.add(solve_step(problem_, h_, s, n, again, z, &chord, &windows, &from))) return out;
+            dz = step_sensitivity(problem_, h_, s, z, &chord, &condition, &windows, n);
+          }
         }
         rep.max_condition = std::max(rep.max_condition, condition);
         if (!(condition <= options_.max_condition)) {  // regular at the predictor, not at the solution
@@ -173,23 +190,33 @@ class DiscreteFlow {
           return out;
         }
         const Eigen::MatrixXd& S = out.sensitivity;
-        // The state's rows (not the group element's); coefficient-based, cheaper than GEMM at these sizes.
-        const Eigen::MatrixXd dzS = dz.lazyProduct(S.topRows(ns));
         next.resize(S.rows(), S.cols());
         using FS = FlowState<P>;
-        next.middleRows(FS::p_offset(0), (2 * k - 1) * r) = S.middleRows(FS::p_offset(1), (2 * k - 1) * r);
-        next.middleRows(FS::p_offset(2 * k - 1), r) = dzS.topRows(r);
-        next.middleRows(FS::g_offset(0), (2 * k - 2) * d) = S.middleRows(FS::g_offset(1), (2 * k - 2) * d);
-        next.middleRows(FS::g_offset(2 * k - 2), d) = dzS.middleRows(r, d);
-        next.middleRows(FS::lam_offset(0), (k - 1) * m) = S.middleRows(FS::lam_offset(1), (k - 1) * m);
-        next.middleRows(FS::lam_offset(k - 1), m) = dzS.bottomRows(m);
-        if constexpr (d > 0) {
-          if (with_group) {  // g_{first+1} = g_first W_first: δ' = Ad_{W^{-1}} δ + J_W δ(p_0, p_1, g~_0)
-            Eigen::Matrix<double, d, 2 * r + d> JW;
-            const auto W = first_increment(problem_, s, &JW);
-            Eigen::MatrixXd old(2 * r + d, S.cols());
-            old << S.middleRows(FS::p_offset(0), 2 * r), S.middleRows(FS::g_offset(0), d);
-            next.bottomRows(d) = G::Ad(G::inverse(W)) * S.bottomRows(d) + JW * old;
+        Eigen::Matrix<double, d, d> AdW;
+        Eigen::Matrix<double, d, 2 * r + d> JW;
+        if constexpr (d > 0) {  // g_{first+1} = g_first W_first: δ' = Ad_{W^{-1}} δ + J_W δ(p_0, p_1, g~_0)
+          if (with_group) AdW = G::Ad(G::inverse(first_increment(problem_, s, &JW)));
+        }
+        // Column by column (each seed's column is contiguous): fixed-size products, no temporary
+        // matrices; dz s_j as a sum of dz's columns (vectorized down each column).
+        for (Eigen::Index j = 0; j < S.cols(); ++j) {
+          const Eigen::Map<const Vec<double, ns>> sj(S.col(j).data());
+          Eigen::Map<Vec<double, ns>> nj(next.col(j).data());
+          Vec<double, D::unknowns> dzs = dz.col(0) * sj(0);
+          for (int c = 1; c < ns; ++c) dzs += dz.col(c) * sj(c);
+          nj.template segment<(2 * k - 1) * r>(FS::p_offset(0)) = sj.template segment<(2 * k - 1) * r>(FS::p_offset(1));
+          nj.template segment<r>(FS::p_offset(2 * k - 1)) = dzs.template head<r>();
+          if constexpr (k > 1 && d > 0)
+            nj.template segment<(2 * k - 2) * d>(FS::g_offset(0)) = sj.template segment<(2 * k - 2) * d>(FS::g_offset(1));
+          if constexpr (d > 0) nj.template segment<d>(FS::g_offset(2 * k - 2)) = dzs.template segment<d>(r);
+          if constexpr (k > 1 && m > 0)
+            nj.template segment<(k - 1) * m>(FS::lam_offset(0)) = sj.template segment<(k - 1) * m>(FS::lam_offset(1));
+          if constexpr (m > 0) nj.template segment<m>(FS::lam_offset(k - 1)) = dzs.template tail<m>();
+          if constexpr (d > 0) {
+            if (with_group)
+              next.col(j).template tail<d>() = AdW * S.col(j).template tail<d>() +
+                                               JW.template leftCols<2 * r>() * sj.template segment<2 * r>(FS::p_offset(0)) +
+                                               JW.template rightCols<d>() * sj.template segment<d>(FS::g_offset(0));
           }
         }
         out.sensitivity.swap(next);

@@ -355,14 +355,6 @@ StepReport solve_galerkin_step(const typename Sch::Model& model, double h, const
   return rep;
 }
 
-// How far, relative to 1 + |z_i|, the exact Newton correction that confirms a predicted step may
-// be: predicted_step_allowance tolerances (newton.hpp), plus the residual's noise as newton_solve
-// allows at a stall (64 u times the step matrix's condition, at most 1e-8).
-inline double predicted_step_bound(const NewtonOptions& opt, double condition) {
-  return predicted_step_allowance * opt.step_tolerance +
-         std::min(1e-8, 64 * std::numeric_limits<double>::epsilon() * condition);
-}
-
 // Confirms a step that newton_solve ended on a prediction (StepReport::predicted), from the
 // evaluation at z its sensitivity made (F there and the exact step matrix, factored): the exact
 // Newton correction at z must be within predicted_step_allowance tolerances (newton.hpp), plus

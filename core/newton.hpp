@@ -74,6 +74,14 @@ struct NewtonOptions {
 // residual.
 constexpr double predicted_step_allowance = 16;
 
+// How far, relative to 1 + |z_i|, the exact Newton correction that confirms a predicted step may
+// be: predicted_step_allowance tolerances, plus the residual's noise as newton_solve allows at a
+// stall (64 u times the step matrix's condition, at most 1e-8).
+inline double predicted_step_bound(const NewtonOptions& opt, double condition) {
+  return predicted_step_allowance * opt.step_tolerance +
+         std::min(1e-8, 64 * std::numeric_limits<double>::epsilon() * condition);
+}
+
 enum class FlowStatus { Ok, NotConverged, Singular, NonFinite, InvalidInput };
 
 struct FlowReport {
