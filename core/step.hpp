@@ -220,6 +220,32 @@ void step_jacobian_from_windows(const P& problem, double h, const FlowState<P>& 
                                    step_column<P>, true, J);
 }
 
+// F and ∂F/∂z at z from window a_n's Hessian (the only window that contains z), given the fixed
+// part of E_n: E_n's rows Σ Bᵀ g and Bᵀ H + Σ g C (step_window_hessian.hpp) over window a_n
+// alone, χ_d(a_n) and its derivatives from the Hessian's λ rows. One pass in Hess arithmetic
+// over the window instead of nested duals through the perturbed increments and the whole block
+// (evaluate_step): a flow without sensitivities evaluates one per step (beanie control: ~60% of
+// its step through nested duals).
+template <class P>
+void step_matrix_from_window(const P& problem, double h, const FlowState<P>& s, const StepUnknowns<P>& z,
+                             const Vec<double, Dims<P>::node>& fixed, Vec<double, Dims<P>::unknowns>& F,
+                             Eigen::Matrix<double, Dims<P>::unknowns, Dims<P>::unknowns>& Jz) {
+  using D = Dims<P>;
+  constexpr int k = D::k, m = D::m, nz = D::unknowns;
+  const NodeBlock<P, double> b = step_block<P, double>(s, z, false);
+  WindowHessian<P> wh;
+  window_hessian(problem, b.window(k), b.lam[k], h, wh);
+  IncrementPerturbation<P> right;  // increment n, its left end at node n (window a_n has no other)
+  if constexpr (D::d > 0) right = increment_perturbation(problem, b.p[k], b.p[k + 1], b.g[k], false);
+  auto window_n = [&](int) -> const WindowHessian<P>& { return wh; };
+  Jz.setZero();
+  node_derivatives_from_windows<P>(
+      window_n, right, right, [](int j, int w) { const int col = step_column<P>(j, w); return col < nz ? col : -1; }, true,
+      Jz, k);
+  F.template head<D::node>() = fixed + node_gradient_from_windows<P>(window_n, k, k, right, right);
+  if constexpr (m > 0) F.template tail<m>() = wh.gradient.template tail<m>();
+}
+
 template <class P>
 void apply_correction(StepUnknowns<P>& z, const Vec<double, Dims<P>::unknowns>& dz) {
   using D = Dims<P>;
@@ -318,7 +344,10 @@ StepReport solve_step(const P& problem, double h, const FlowState<P>& s, int n, 
     return newton_solve<nz>(
         n, opt,
         [&](Vec<double, nz>& F, Eigen::Matrix<double, nz, nz>& J) {
-          evaluate_step<P, nz>(problem, h, s, z, false, &fixed, F, J);
+          if constexpr (uses_window_hessians<P>())
+            step_matrix_from_window(problem, h, s, z, fixed, F, J);
+          else
+            evaluate_step<P, nz>(problem, h, s, z, false, &fixed, F, J);
         },
         [&](Vec<double, nz>& F) { F = step_residual(problem, h, s, z, fixed); },
         [&](const Vec<double, nz>& dz) { apply_correction(z, dz); },

@@ -246,17 +246,18 @@ Vec<double, Dims<P>::node> node_gradient_from_windows(HessianOf&& hessian_of, in
   return E;
 }
 
-// ∂E_c/∂x for node c = k of the block from windows 0 .. k, and, if with_constraints, ∂χ_d/∂x of
-// window k's in rows node..; columns placed by column(j, w) (window j's coordinate w). Each
-// window's Hessian comes from hessian_of(j); left and right as step_increment_perturbation's.
+// ∂E_c/∂x for node c = k of the block from windows first .. k, and, if with_constraints, ∂χ_d/∂x
+// of window k's in rows node..; columns placed by column(j, w) (window j's coordinate w; negative:
+// not wanted). Each window's Hessian comes from hessian_of(j); left and right as
+// step_increment_perturbation's.
 template <class P, int Rows, int Cols, class HessianOf, class Column>
 void node_derivatives_from_windows(HessianOf&& hessian_of, const IncrementPerturbation<P>& left,
                                    const IncrementPerturbation<P>& right, Column&& column, bool with_constraints,
-                                   Eigen::Matrix<double, Rows, Cols>& J) {
+                                   Eigen::Matrix<double, Rows, Cols>& J, int first = 0) {
   constexpr int k = P::order, r = P::shape_dim, d = P::Group::dim, m = P::num_constraints, node = r + d;
   constexpr int nw = window_coordinates<P>(), c = k;
   using IP = IncrementPerturbation<P>;
-  for (int j = 0; j <= k; ++j) {
+  for (int j = first; j <= k; ++j) {
     const WindowHessian<P>& wh = hessian_of(j);
     const auto& H = wh.hessian;
     Eigen::Matrix<double, node, nw> dE = Eigen::Matrix<double, node, nw>::Zero();
@@ -278,6 +279,7 @@ void node_derivatives_from_windows(HessianOf&& hessian_of, const IncrementPertur
     }
     for (int w = 0; w < nw; ++w) {
       const int col = column(j, w);
+      if (col < 0) continue;
       for (int i = 0; i < node; ++i) J(i, col) += dE(i, w);
       if constexpr (m > 0) {
         if (with_constraints && j == k)

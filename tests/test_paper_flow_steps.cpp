@@ -25,6 +25,19 @@ FlowState<BeanieControl> smooth_start(const BeanieControl& b, double h) {
                                 lam0 + h * dlam, h);
 }
 
+// L_d = ½ p_0 (p_2 - c)² + ½ (p_1 - p_0)²: step n's matrix ∂E_n/∂p_{n+2} = p_{n+2} - c, singular
+// where the new node is c.
+struct SquareProblem {
+  using Group = Trivial;
+  static constexpr int shape_dim = 1, order = 2, num_constraints = 0;
+  double c = 4.0;
+  template <class T>
+  T lagrangian(const Window<SquareProblem, T>& a, double) const {
+    const T gap = a.p[2](0) - c, dp = a.p[1](0) - a.p[0](0);
+    return 0.5 * a.p[0](0) * gap * gap + 0.5 * dp * dp;
+  }
+};
+
 struct PredictorErrors {
   double p, g, lam;
 };
@@ -137,4 +150,30 @@ TEST(PaperFlowSteps, ConfirmedStepsSolveTheirEquationsToTheRoundingLevel) {
     EXPECT_LT(worst_residual(seeded.trajectory), 10 * worst_residual(plain.trajectory)) << "h = " << h;
     EXPECT_LE(seeded.report.total_iterations, 2 * seeded.report.steps) << "h = " << h;
   }
+}
+
+// Nodes 3, 1, 3, 4: the extrapolated predictor of the next node is 4 (quadratic), the plain one 5
+// (linear), and E_n = ½ (z - 4)² - 2 (windows n, n-1, n-2: ½ (z - 4)² - 1, 2, 3 (3 - 4)), whose
+// root beyond the plain predictor is z = 6. With c = 4 the step matrix vanishes at the
+// extrapolated predictor, so Newton from there stops as singular; the step is then solved from the
+// plain predictor, and the report counts both attempts' iterations.
+TEST(PaperFlowSteps, AStepSingularAtTheExtrapolatedPredictorIsSolvedFromThePlainOne) {
+  const SquareProblem problem;
+  const double h = 0.1;
+  FlowState<SquareProblem> s;
+  s.p = {Vec<double, 1>(3.0), Vec<double, 1>(1.0), Vec<double, 1>(3.0), Vec<double, 1>(4.0)};
+  StepUnknowns<SquareProblem> z;
+  step_predictor(s, true, z);
+  ASSERT_EQ(z.p(0), problem.c);
+  Vec<double, 1> F;
+  Eigen::Matrix<double, 1, 1> J;
+  const Vec<double, 1> fixed = step_fixed_part(problem, h, s, z);
+  evaluate_step<SquareProblem, 1>(problem, h, s, z, false, &fixed, F, J);
+  EXPECT_EQ(J(0, 0), 0.0);  // singular there
+
+  const StepReport rep = solve_step(problem, h, s, 2, NewtonOptions{}, z);
+  ASSERT_EQ(rep.status, StepStatus::Converged) << rep.message;
+  EXPECT_GE(rep.iterations, 2);
+  EXPECT_LT(std::abs(step_residual(problem, h, s, z, fixed)(0)), 1e-12);
+  EXPECT_NEAR(z.p(0), 6.0, 1e-12);
 }

@@ -140,6 +140,14 @@ void check_step_derivatives_at(const P& problem, double h, const FlowResult<P>& 
         step_increment_perturbation(problem, b, carried, n, false), step_increment_perturbation(problem, b, carried, n, true));
     const double scale = std::max(1.0, F1.template lpNorm<Eigen::Infinity>());
     EXPECT_LT((E - F1.template head<D::node>()).template lpNorm<Eigen::Infinity>(), 1e-13 * scale);
+    // Newton's F and ∂F/∂z alone (solve_step), from window a_n's Hessian against nested duals.
+    const Vec<double, D::node> fixed = step_fixed_part(problem, h, s, z);
+    Vec<double, nz> F5, F6;
+    Eigen::Matrix<double, nz, nz> J5, J6;
+    evaluate_step<P, nz>(problem, h, s, z, false, &fixed, F5, J5);
+    step_matrix_from_window(problem, h, s, z, fixed, F6, J6);
+    EXPECT_LT((F5 - F6).template lpNorm<Eigen::Infinity>(), 1e-13 * scale);
+    EXPECT_LT((J5 - J6).template lpNorm<Eigen::Infinity>(), 1e-13 * J5.template lpNorm<Eigen::Infinity>());
   }
 }
 
