@@ -5,7 +5,7 @@
 #pragma once
 
 #include "degree.hpp"
-#include "step.hpp"
+#include "step_solve.hpp"
 
 #include <Eigen/Core>
 
@@ -165,6 +165,10 @@ class DiscreteFlow {
       StepUnknowns<P> z;
       const StepReport step = solve_step(problem_, h_, s, n, step_options, z, chord_used, seed ? &windows : nullptr);
       if (!rep.add(step)) return out;
+      // W of the state's first node (it does not depend on z): g_first's update, and with the
+      // group seeded, its sensitivity's Jacobian JW.
+      Eigen::Matrix<double, d, 2 * r + d> JW;
+      const GroupElement<P, double> W_first = first_increment(problem_, s, with_group ? &JW : nullptr);
       if (seed) {
         // New state = shifted old state + z; the new rows come from the implicit function theorem.
         if (!dz_current) {
@@ -193,9 +197,8 @@ class DiscreteFlow {
         next.resize(S.rows(), S.cols());
         using FS = FlowState<P>;
         Eigen::Matrix<double, d, d> AdW;
-        Eigen::Matrix<double, d, 2 * r + d> JW;
         if constexpr (d > 0) {  // g_{first+1} = g_first W_first: δ' = Ad_{W^{-1}} δ + J_W δ(p_0, p_1, g~_0)
-          if (with_group) AdW = G::Ad(G::inverse(first_increment(problem_, s, &JW)));
+          if (with_group) AdW = G::Ad(G::inverse(W_first));
         }
         // Column by column (each seed's column is contiguous): fixed-size products, no temporary
         // matrices; dz s_j as a sum of dz's columns (vectorized down each column).
@@ -221,7 +224,7 @@ class DiscreteFlow {
         }
         out.sensitivity.swap(next);
       }
-      out.g_first = G::compose(out.g_first, first_increment<P>(problem_, s, nullptr));
+      out.g_first = G::compose(out.g_first, W_first);
       // Shift the state and store the new unknowns.
       for (int i = 0; i + 1 < 2 * k; ++i) s.p[i] = s.p[i + 1];
       s.p[2 * k - 1] = z.p;

@@ -11,4 +11,4 @@
 #include "momentum.hpp"
 #include "paper_windows.hpp"
 #include "problem.hpp"
-#include "step.hpp"
+#include "step_solve.hpp"

@@ -72,7 +72,7 @@ TEST(AnalyticSteps, BeanieControlStepMatchesHandSolvedStep) {
   });
 }
 
-// The engine's step sensitivity (implicit function theorem on derived Jacobians, step.hpp) against
+// The engine's step sensitivity (implicit function theorem on derived Jacobians, step_solve.hpp) against
 // the hand-written tangent-linear step, at states along a flow with non-zero multipliers. The
 // oracle is first checked against central differences of the hand-solved step itself.
 TEST(AnalyticSteps, BeanieControlSensitivityMatchesHandWrittenTangent) {

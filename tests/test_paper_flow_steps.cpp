@@ -1,4 +1,4 @@
-// How the paper scheme's flow starts and ends its steps (core/step.hpp): the extrapolated
+// How the paper scheme's flow starts and ends its steps (core/step_solve.hpp): the extrapolated
 // predictor's order in h, and a step ended on a prediction, confirmed by one exact Newton
 // correction from the window Hessians its sensitivity computes.
 #include "helpers.hpp"
