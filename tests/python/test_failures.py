@@ -45,6 +45,8 @@ def test_not_converging_returns_the_reason():
     assert r.message and "nan" not in r.message.lower()
     assert r.trajectory == {} and r.momentum == {}
     assert r.report["converged"] is False
+    # Its repr gives the reason, not a missing value.
+    assert repr(r) == f"<lpshoot.Result electron not_converged, N={r.report['N']}: {r.message}>"
 
 
 def test_output_errors(tmp_path):

@@ -34,6 +34,8 @@ def test_run_matches_cli(work, command, name, sets):
     if (work / "cli" / "trajectory_extrapolated.csv").exists():
         assert_same_columns(r.extrapolated, read_csv(work / "cli" / "trajectory_extrapolated.csv"))
     assert r.cost == cli_report["cost"] and r.iterations == cli_report["iterations"]
+    value = f"cost={r.cost:.10g}" if r.cost is not None else f"action={r.action:.10g}"
+    assert repr(r) == f"<lpshoot.Result {cli_report['problem']} converged, N={cli_report['N']}: {value}>"
 
     # The result writes the same files as the CLI, with the same contents.
     files = r.write(work / "py", plot=False)

@@ -114,8 +114,12 @@ class Result:
                                self._run.plot if plot is None else bool(plot))
 
     def __repr__(self):
-        what = f"cost={self.cost:.10g}" if self.cost is not None else f"action={self.action!r}"
-        return f"<lpshoot.Result {self.report['problem']} {self.status}: {what}, N={self.report['N']}>"
+        head = f"<lpshoot.Result {self.report['problem']} {self.status}, N={self.report['N']}"
+        if not self.converged:  # no value to show: the reason instead
+            return f"{head}: {self.message}>"
+        if self.cost is not None:
+            return f"{head}: cost={self.cost:.10g}>"
+        return f"{head}: action={self.action:.10g}>" if self.action is not None else head + ">"
 
 
 class SweepResult:
