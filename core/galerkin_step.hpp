@@ -401,14 +401,8 @@ Eigen::Matrix<double, Sch::unknowns, Sch::state> galerkin_step_sensitivity(
   Vec<double, nz> F;
   Eigen::Matrix<double, nz, nz + ns> J;
   evaluate_galerkin_step<Sch, nz + ns>(model, h, state, z, true, nullptr, F, J, carry);
-  const Eigen::Matrix<double, nz, nz> Jz = J.template leftCols<nz>();
-  const Eigen::Matrix<double, nz, ns> Js = J.template rightCols<ns>();
-  ChordMatrix<nz> own;
-  ChordMatrix<nz>& factored = chord ? *chord : own;
-  const Eigen::Matrix<double, nz, ns> dz = implicit_sensitivity<nz, ns>(Jz, Js, factored);
-  if (condition) *condition = factored.condition;
   if (residual) *residual = F;
-  return dz;
+  return implicit_sensitivity<nz, ns>(J, chord, condition);
 }
 
 }  // namespace lpshoot

@@ -157,15 +157,20 @@ struct ChordMatrix {
 };
 
 // dz/d(state) = -(∂F/∂z)^{-1} ∂F/∂(state) at a solved step (the implicit function theorem),
-// leaving ∂F/∂z factored in `factored` with its 1-norm condition number (the regularity check at
-// the solution; a flow stops at a singular one, so the matrix is marked valid for chord steps).
+// from J = [∂F/∂z  ∂F/∂(state)], leaving ∂F/∂z factored in `chord` (if given) with its 1-norm
+// condition number, also returned in `condition` (the regularity check at the solution; a flow
+// stops at a singular one, so the matrix is marked valid for chord steps).
 template <int nz, int ns>
-Eigen::Matrix<double, nz, ns> implicit_sensitivity(const Eigen::Matrix<double, nz, nz>& Jz,
-                                                   const Eigen::Matrix<double, nz, ns>& Js, ChordMatrix<nz>& factored) {
+Eigen::Matrix<double, nz, ns> implicit_sensitivity(const Eigen::Matrix<double, nz, nz + ns>& J, ChordMatrix<nz>* chord,
+                                                   double* condition) {
+  ChordMatrix<nz> own;
+  ChordMatrix<nz>& factored = chord ? *chord : own;
+  const Eigen::Matrix<double, nz, nz> Jz = J.template leftCols<nz>();
   factored.lu.compute(Jz);
   factored.condition = condition_number_1(Jz, factored.lu);
   factored.valid = true;
-  return -factored.lu.solve(Js);
+  if (condition) *condition = factored.condition;
+  return -factored.lu.solve(Eigen::Matrix<double, nz, ns>(J.template rightCols<ns>()));
 }
 
 // Solves F(z) = 0 for a step with n unknowns. The callbacks:

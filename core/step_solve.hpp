@@ -197,13 +197,7 @@ Eigen::Matrix<double, Dims<P>::unknowns, Dims<P>::state> step_sensitivity(
     Vec<double, nz> F;
     evaluate_step_by_window(problem, h, s, z, F, J);
   }
-  const Eigen::Matrix<double, nz, nz> Jz = J.template leftCols<nz>();
-  const Eigen::Matrix<double, nz, ns> Js = J.template rightCols<ns>();
-  ChordMatrix<nz> own_chord;
-  ChordMatrix<nz>& factored = chord ? *chord : own_chord;
-  const Eigen::Matrix<double, nz, ns> dz = implicit_sensitivity<nz, ns>(Jz, Js, factored);
-  if (condition) *condition = factored.condition;
-  return dz;
+  return implicit_sensitivity<nz, ns>(J, chord, condition);
 }
 
 }  // namespace lpshoot
