@@ -81,11 +81,11 @@ Vec<double, IntervalDerivatives<Sch>::ne> flat_interval_gradient(const typename 
   const auto& tab = GalerkinTable<Sch::degree, Sch::gauss>::get();
   const Vec<double, ny> y = flat_coordinates_of(iv);
   Vec<double, D::ne> out = Vec<double, D::ne>::Zero();
+  Jet<typename Sch::Model, T1> q;  // constructed (zeroed) once: every entry is set at each point
   for (int i = 0; i < Sch::gauss; ++i) {
     const double w = h * tab.b[i];
     const FlatJetMap<Sch> K(h, i);
     const Vec<double, nq> qv = K.jet(y);
-    Jet<typename Sch::Model, T1> q;
     for (int a = 0; a < r; ++a)
       q.p(a) = T1::variable(qv(a), a), q.dp(a) = T1::variable(qv(r + a), r + a),
       q.ddp(a) = T1::variable(qv(2 * r + a), 2 * r + a);
@@ -233,6 +233,25 @@ struct StepCarry {
   IntervalDerivatives<Sch> interval{};
 };
 
+// ∂F/∂z and, when NO > nz, the state's columns ∂F/∂state (file comment) from interval n's Hessian
+// and, if given, the state's (without it the state's columns hold interval n's part alone).
+template <class Sch, int NO>
+void flat_step_jacobian(const FlatStepMaps<Sch>& maps, double h,
+                        const Eigen::Matrix<double, FlatStepMaps<Sch>::ne, FlatStepMaps<Sch>::ne>& right_hessian,
+                        const Eigen::Matrix<double, FlatStepMaps<Sch>::ne, FlatStepMaps<Sch>::ne>* left_hessian,
+                        Eigen::Matrix<double, Sch::unknowns, NO>& J) {
+  constexpr int nz = Sch::unknowns;
+  const double inv_h = 1.0 / h;
+  const Eigen::Matrix<double, nz, FlatStepMaps<Sch>::ne> AH = inv_h * (maps.right * right_hessian);
+  J.template leftCols<nz>().noalias() = AH * maps.unknowns;
+  if constexpr (NO != nz) {
+    J.template rightCols<NO - nz>().noalias() = AH * maps.base;
+    if (left_hessian) J.template rightCols<NO - nz>().noalias() += inv_h * (maps.left * *left_hessian);
+  } else {
+    (void)left_hessian;
+  }
+}
+
 // evaluate_galerkin_step (galerkin_step.hpp) for d = 0: same arguments and results. `carry`, when
 // valid, holds the state's derivatives; on return it holds interval n's.
 template <class Sch, int NO>
@@ -240,8 +259,7 @@ void evaluate_galerkin_step_flat(const typename Sch::Model& model, double h, con
                                  const Interval<Sch, double>& z, bool with_state,
                                  const Vec<double, Sch::variation>* fixed, Vec<double, Sch::unknowns>& F,
                                  Eigen::Matrix<double, Sch::unknowns, NO>& J, StepCarry<Sch>* carry = nullptr) {
-  constexpr int nz = Sch::unknowns, nv = Sch::variation;
-  constexpr bool state_cols = NO != nz;
+  constexpr int nv = Sch::variation;
   const FlatStepMaps<Sch> maps(h);
   Interval<Sch, double> right = z;
   const Interval<Sch, double> b = next_interval_base(state, h);
@@ -249,17 +267,14 @@ void evaluate_galerkin_step_flat(const typename Sch::Model& model, double h, con
   const IntervalDerivatives<Sch> dr = flat_interval_derivatives<Sch>(model, right, h);
   const double inv_h = 1.0 / h;
   F.noalias() = inv_h * (maps.right * dr.gradient);
-  const Eigen::Matrix<double, nz, FlatStepMaps<Sch>::ne> AH = inv_h * (maps.right * dr.hessian);
-  J.template leftCols<nz>().noalias() = AH * maps.unknowns;
-  if constexpr (state_cols) J.template rightCols<NO - nz>().noalias() = AH * maps.base;
   if (fixed) {
+    flat_step_jacobian<Sch, NO>(maps, h, dr.hessian, nullptr, J);
     F.template head<nv>() += *fixed;
   } else {
     const IntervalDerivatives<Sch> dl =
         carry && carry->valid ? carry->interval : flat_interval_derivatives<Sch>(model, state, h);
     F.noalias() += inv_h * (maps.left * dl.gradient);
-    if constexpr (state_cols)
-      if (with_state) J.template rightCols<NO - nz>().noalias() += inv_h * (maps.left * dl.hessian);
+    flat_step_jacobian<Sch, NO>(maps, h, dr.hessian, with_state ? &dl.hessian : nullptr, J);
   }
   if (carry) {
     carry->interval = dr;

@@ -116,7 +116,7 @@ class GalerkinFlow {
     // the first step's factored matrix: one evaluation per step. The correction is needed: the
     // map alone is off by δ(dz) |state - state_0|, δ(dz) ~ cond(J) u |dz|.
     ChordMatrix<nz> chord;
-    ChordMatrix<nz>* const chord_used = seed || d > 0 ? &chord : nullptr;
+    ChordMatrix<nz>* const chord_used = seed || d > 0 || affine_ ? &chord : nullptr;
     NewtonOptions step_options = options_;  // chord-ended steps of a trajectory: polished (newton.hpp)
     step_options.polish_chord = !seed && d > 0;
     // With sensitivities and a group, the step's sensitivity evaluates it at the solution
@@ -155,6 +155,8 @@ class GalerkinFlow {
     const bool predictions_taken = seed && d > 0 && !affine_;  // affine: one sensitivity per flow
     double last_prediction_error = std::numeric_limits<double>::infinity();
     if (record && seed) out.memo.reserve(steps);
+    if constexpr (d == 0)
+      if (affine_ && steps > 0) dz_current = affine_start(start, carry, chord, dz, condition);
     for (int k = 1; k <= steps; ++k) {
       Interval<Sch, double> z;
       Vec<double, nz> predicted, from_guide;
@@ -193,6 +195,8 @@ class GalerkinFlow {
         if (step.noise_sample > 0 && !seed) step_options.noise_floor = step.noise_sample;
       }
       if (!rep.add(step)) return out;
+      if constexpr (d == 0)  // the carry held the start interval's derivatives (affine_start)
+        if (affine_ && k == 1 && dz_current) carry.interval.gradient = flat_interval_gradient<Sch>(model_, z, h_);
       if (seed || affine_) {
         if (!dz_current) {
           Vec<double, nz> F_at_z;
@@ -270,8 +274,10 @@ class GalerkinFlow {
         out.sensitivity.swap(next);
       }
       out.g_last = G::compose(out.g_last, s.W);
-      earlier = before;
-      before = s;
+      if constexpr (d > 0) {  // the extrapolation's intervals
+        earlier = before;
+        before = s;
+      }
       s = z;
       if (keep)
         ivs.push_back(z);
@@ -282,6 +288,26 @@ class GalerkinFlow {
   }
 
  private:
+  // Affine steps (d = 0): every interval's Hessian is the same matrix (degree.hpp), so one
+  // evaluation, at the start interval, gives the carry (the state's part of step 1's equations)
+  // and step 1's matrix, factored, its condition and its sensitivity, as galerkin_step_sensitivity
+  // gives them at step 1's solution from two more (electron Galerkin 4: three interval Hessians
+  // in nested duals, ~13 µs, were a 200-step flow's first step). Step 1 is then solved by chord
+  // steps on its exact matrix. False (nothing to reuse) when the matrix is too ill-conditioned:
+  // step 1 then evaluates its own and reports it.
+  bool affine_start(const Interval<Sch, double>& start, StepCarry<Sch>& carry, ChordMatrix<Sch::unknowns>& chord,
+                    Eigen::Matrix<double, Sch::unknowns, Sch::state>& dz, double& condition) const {
+    constexpr int nz = Sch::unknowns, ns = Sch::state;
+    carry.interval = flat_interval_derivatives<Sch>(model_, start, h_);
+    carry.valid = true;
+    Eigen::Matrix<double, nz, nz + ns> J;
+    flat_step_jacobian<Sch, nz + ns>(FlatStepMaps<Sch>(h_), h_, carry.interval.hessian, &carry.interval.hessian, J);
+    dz = implicit_sensitivity<nz, ns>(J, &chord, &condition);
+    if (condition <= options_.max_condition) return true;
+    chord.valid = false;
+    return false;
+  }
+
   // The next interval's unknowns (solve_galerkin_step's predictor layout) extrapolated in n from
   // intervals a0 = n-3 (if given: quadratic; else linear), a = n-2 and b = n-1; W_n as
   // W_{n-1} D with log D extrapolated from the last increments D_k = W_{k-1}^{-1} W_k.

@@ -34,9 +34,10 @@ struct Hess {
   template <class A, std::enable_if_t<std::is_arithmetic_v<A> && !std::is_same_v<A, double>, int> = 0>
   Hess(A value) : v(double(value)) {}  // NOLINT
 
+  // g copied whole from a unit vector, as Dual::variable (dual.hpp: a store-forwarding stall).
   static Hess variable(double x, int i) {
     Hess r(x);
-    r.g[i] = 1.0;
+    r.g = Dual<double, N>::units[i];
     return r;
   }
   // Index of H(i, j), i <= j, in the packed storage (row-major upper triangle).

@@ -19,6 +19,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -195,8 +196,8 @@ StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian,
   using Vn = Eigen::Matrix<double, n, 1>;
   Vn F;
   Eigen::Matrix<double, n, n> J;
-  ChordMatrix<n> own;
-  ChordMatrix<n>& factored = chord ? *chord : own;
+  std::optional<ChordMatrix<n>> own;  // only without a caller's: its zeroing cost a flow step ~4%
+  ChordMatrix<n>& factored = chord ? *chord : own.emplace();
   auto& lu = factored.lu;
   bool refresh = !(factored.valid && factored.condition <= opt.max_condition);
   if (!refresh) rep.condition = factored.condition;

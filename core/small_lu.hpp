@@ -4,6 +4,11 @@
 // dynamic matrices (gebp, trsm, packing): at the Galerkin 6 beanie step (n = 21, 26 right-hand
 // sides) its factorization and many-column solve took 2.0 and 3.3 µs, these loops 1.5 and 1.7 µs
 // (bench/RESULTS.md, "Small step matrices"). Same pivots, results equal to rounding.
+// The one-vector solves work on a local array with fully unrolled loops: written through the
+// result (or with Eigen's run-time-sized segments) every update went through memory, in a
+// serial chain of store-to-load forwarding (7 × 7: 102 against 33 ns; bench/RESULTS.md, "The
+// small solves in registers"). solve() keeps the order of operations, so its results are the
+// same to the bit.
 // A zero pivot is kept (no division): solves then return inf or NaN, which the condition
 // estimate reports as a singular matrix (newton.hpp), as with Eigen's.
 #pragma once
@@ -36,17 +41,27 @@ class SmallLU {
       if (lu_(k, k) != 0) lu_.col(k).tail(below) /= lu_(k, k);
       for (int j = k + 1; j < n; ++j) lu_.col(j).tail(below) -= lu_(k, j) * lu_.col(k).tail(below);
     }
+    for (int i = 0; i < n; ++i) row_[i] = i;
+    for (int k = 0; k < n; ++k) std::swap(row_[k], row_[pivot_[k]]);
   }
 
   // A^{-1} b: the interchanges, then L (unit) and U by column updates.
   Vector solve(const Vector& b) const {
-    Vector x = b;
-    for (int k = 0; k < n; ++k) std::swap(x(k), x(pivot_[k]));
-    for (int k = 0; k < n - 1; ++k) x.tail(n - k - 1) -= x(k) * lu_.col(k).tail(n - k - 1);
+    double t[n];
+#pragma GCC unroll 32
+    for (int i = 0; i < n; ++i) t[i] = b(row_[i]);
+#pragma GCC unroll 32
+    for (int k = 0; k < n - 1; ++k)
+#pragma GCC unroll 32
+      for (int i = k + 1; i < n; ++i) t[i] -= t[k] * lu_(i, k);
+#pragma GCC unroll 32
     for (int k = n - 1; k >= 0; --k) {
-      x(k) /= lu_(k, k);
-      x.head(k) -= x(k) * lu_.col(k).head(k);
+      t[k] /= lu_(k, k);
+#pragma GCC unroll 32
+      for (int i = 0; i < k; ++i) t[i] -= t[k] * lu_(i, k);
     }
+    Vector x;
+    for (int i = 0; i < n; ++i) x(i) = t[i];
     return x;
   }
 
@@ -70,12 +85,24 @@ class SmallLU {
     return xt.transpose();
   }
 
-  // A^{-T} b = P^T L^{-T} U^{-T} b: dot products with the factors' columns.
+  // A^{-T} b = P^T L^{-T} U^{-T} b: Uᵀ then Lᵀ (unit) by column updates with the factors' rows,
+  // then the interchanges undone.
   Vector solve_transposed(const Vector& b) const {
-    Vector x = b;
-    for (int i = 0; i < n; ++i) x(i) = (x(i) - lu_.col(i).head(i).dot(x.head(i))) / lu_(i, i);
-    for (int i = n - 2; i >= 0; --i) x(i) -= lu_.col(i).tail(n - i - 1).dot(x.tail(n - i - 1));
-    for (int k = n - 1; k >= 0; --k) std::swap(x(k), x(pivot_[k]));
+    double t[n];
+#pragma GCC unroll 32
+    for (int i = 0; i < n; ++i) t[i] = b(i);
+#pragma GCC unroll 32
+    for (int k = 0; k < n; ++k) {
+      t[k] /= lu_(k, k);
+#pragma GCC unroll 32
+      for (int i = k + 1; i < n; ++i) t[i] -= t[k] * lu_(k, i);
+    }
+#pragma GCC unroll 32
+    for (int k = n - 1; k > 0; --k)
+#pragma GCC unroll 32
+      for (int i = 0; i < k; ++i) t[i] -= t[k] * lu_(k, i);
+    Vector x;
+    for (int i = 0; i < n; ++i) x(row_[i]) = t[i];
     return x;
   }
 
@@ -93,6 +120,7 @@ class SmallLU {
  private:
   Matrix lu_ = Matrix::Zero();
   std::array<int, n> pivot_{};  // row k was interchanged with row pivot_[k] >= k
+  std::array<int, n> row_{};    // row i of PA is row row_[i] of A
 };
 
 }  // namespace lpshoot

@@ -56,6 +56,17 @@ struct Branching {
   }
 };
 
+// ½ p₀''²: quadratic, but p₁ does not enter, so every step matrix is singular.
+struct MissingCoordinate {
+  using Group = Trivial;
+  static constexpr int shape_dim = 2;
+  static constexpr int num_constraints = 0;
+  template <class T>
+  T lagrangian(const Jet<MissingCoordinate, T>& q) const {
+    return 0.5 * q.ddp(0) * q.ddp(0);
+  }
+};
+
 // ½ |p''|² / m + √(1 + p'²): the root is not a polynomial.
 struct WithRoot {
   using Group = Trivial;
@@ -180,6 +191,27 @@ TEST(DegreeProbe, TellsAffineStepsFromOthers) {
 TEST(AffineFlows, GalerkinElectronEqualsNewtonAtEveryStep) {
   expect_affine_galerkin_flow<Galerkin<ElectronModel, 3>>(0.01, 300);
   expect_affine_galerkin_flow<Galerkin<ElectronModel, 4>>(0.02, 150);
+}
+
+// An affine flow takes step 1's matrix and sensitivity from the start interval's Hessian
+// (galerkin_flow.hpp, affine_start); a singular one is still reported at step 1, with and
+// without sensitivities, as by the flow that evaluates every step's matrix.
+TEST(AffineFlows, ASingularAffineStepIsReportedAtStepOne) {
+  using Sch = Galerkin<MissingCoordinate, 3>;
+  Interval<Sch, double> start;
+  start.x << 0.3, -0.2, start.v << 1.0, 0.5, start.X2 << 0.0, 0.1, start.V1 << 0.0, -0.2;
+  const GalerkinFlow<Sch> affine(MissingCoordinate{}, 0.05), newton(MissingCoordinate{}, 0.05, every_step());
+  ASSERT_TRUE(affine.affine());
+  const Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(Sch::state, Sch::state);
+  for (const Eigen::MatrixXd* s : {&seed, static_cast<const Eigen::MatrixXd*>(nullptr)}) {
+    const auto a = affine.run(start, 10, s), b = newton.run(start, 10, s);
+    EXPECT_EQ(a.report.status, FlowStatus::Singular) << a.report.message;
+    EXPECT_EQ(a.report.failed_step, 1);
+    EXPECT_EQ(a.report.steps, 0);
+    EXPECT_NE(a.report.message.find("step n=1: the step matrix (Proposition 2) is singular"), std::string::npos)
+        << a.report.message;
+    EXPECT_EQ(a.report.message, b.report.message);
+  }
 }
 
 TEST(AffineFlows, GalerkinWithLinearConstraintEqualsNewtonAtEveryStep) {
