@@ -1,0 +1,126 @@
+// Issue 9's "derived step with sensitivities within 3x of a hand-written one", measured as a
+// ratio in one process: each pair (engine, hand-written) is timed alternately, 40 rounds, and
+// the minimum of each side is kept, so a slow spell of a shared machine (they last seconds to
+// minutes here, and moved bench_step's separate medians by up to 1.5x) hits both sides or
+// neither. Pairs:
+//   - the electron Galerkin 4 flow, 200 steps, 12 state directions seeded, per step, against
+//     the hand-written flow of bench_galerkin_step (the step map formed once per flow);
+//   - the beanie control step of the paper scheme as a flow takes it (bench_step's "as in a
+//     flow" loop: carried window Hessians, the chord matrix), against the hand-written step
+//     with its tangent-linear sensitivity (tests/oracles/analytic_steps.cpp).
+//   ./build/bench/bench_ratios
+#include <lpshoot/problems/electron_bvp.hpp>
+
+#include "oracles/analytic_steps.hpp"
+#include "oracles/galerkin_electron.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+
+using namespace lpshoot;
+using namespace lpshoot::problems;
+
+namespace {
+
+template <class F>
+double nanoseconds_per_call(F&& f, int calls) {
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < calls; ++i) f();
+  return std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count() / calls;
+}
+
+// Minimum over alternated rounds of each side's time per call.
+template <class A, class B>
+std::pair<double, double> alternated_minima(A&& a, B&& b, int calls, int rounds = 40) {
+  double ta = 1e300, tb = 1e300;
+  for (int r = 0; r < rounds; ++r) {
+    ta = std::min(ta, nanoseconds_per_call(a, calls));
+    tb = std::min(tb, nanoseconds_per_call(b, calls));
+  }
+  return {ta, tb};
+}
+
+void electron_galerkin_flow() {
+  using Sch = ElectronGalerkin<3>;
+  constexpr double h = 0.01;
+  constexpr int steps = 200;
+  const ElectronModel m = model_of(Electron{});
+  ElectronBoundary a, b;
+  a.position = {1, 0, 0.5}, a.velocity = {0, 1, 0}, b.position = {0, 1, -0.5}, b.velocity = {-1, 0, 0.2};
+  const auto bvp = electron_galerkin_bvp<3>(m, 2.0, 200, a, b);
+  const auto start = electron_galerkin_guess<3>(bvp, a, b).trajectory.intervals[0];
+  const GalerkinFlow<Sch> flow(m, h);
+  const Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(Sch::state, Sch::state);
+  auto engine = [&] {
+    const auto r = flow.run(start, steps, &seed, Sch::Group::template identity<double>(), 0, false);
+    if (!r.report.ok()) std::printf("electron flow failed: %s\n", r.report.message.c_str());
+    asm volatile("" : : "r"(r.sensitivity.data()) : "memory");
+  };
+  oracles::GalerkinElectronState c0;
+  c0 << start.x, start.v, start.X2, start.V1;
+  auto hand = [&] {  // as BM_ElectronHandGalerkinFlow/1
+    const oracles::GalerkinElectronMap Phi = oracles::electron_galerkin4_step_map(m, h);
+    oracles::GalerkinElectronState c = c0, cn;
+    Eigen::Matrix<double, 12, 12> S = Eigen::Matrix<double, 12, 12>::Identity(), next;
+    for (int k = 0; k < steps; ++k) {
+      cn.head<3>() = c.head<3>() + h * c.segment<3>(3) + (h * h) * c.segment<3>(6);
+      cn.segment<3>(3) = c.segment<3>(3) + h * c.tail<3>();
+      cn.tail<6>().noalias() = Phi * c;
+      c.swap(cn);
+      next.topRows<3>() = S.topRows<3>() + h * S.middleRows<3>(3) + (h * h) * S.middleRows<3>(6);
+      next.middleRows<3>(3) = S.middleRows<3>(3) + h * S.bottomRows<3>();
+      next.bottomRows<6>().noalias() = Phi.lazyProduct(S);
+      S.swap(next);
+    }
+    asm volatile("" : : "r"(c.data()), "r"(S.data()) : "memory");
+  };
+  const auto [te, th] = alternated_minima(engine, hand, 500);
+  std::printf("electron Galerkin 4 flow with sensitivities, per step: engine %.0f ns, hand-written %.0f ns, ratio %.2f\n",
+              te / steps, th / steps, te / th);
+}
+
+FlowState<BeanieControl> beanie_state(const BeanieControl& b, double h) {  // bench_step's
+  FlowState<BeanieControl> s;
+  for (int i = 0; i < 4; ++i) s.p[i] = Vec<double, 1>(0.5 + 0.8 * i * h - 0.25 * (i * h) * (i * h));
+  s.g[0] = {0.6 * h, Eigen::Vector2d(0.8 * h, -0.3 * h)};
+  for (int i = 1; i < 3; ++i) s.g[i] = b.next_increment(s.g[i - 1], s.p[i](0) - s.p[i - 1](0));
+  s.lam = {Eigen::Vector3d(0.3, -0.2, 0.1), Eigen::Vector3d(0.302, -0.199, 0.101)};
+  return s;
+}
+
+void beanie_paper_step() {
+  using P = BeanieControl;
+  BeanieControl b;
+  b.par = {1.0, 1.0, 0.5, 1.0};
+  const double h = 0.01;
+  const auto s = beanie_state(b, h);
+  const NewtonOptions opt;
+  StepUnknowns<P> z;
+  WindowHessianCarry<P> carry;
+  ChordMatrix<Dims<P>::unknowns> previous;
+  solve_step(b, h, s, 2, opt, z);
+  step_sensitivity(b, h, s, z, &previous, nullptr, &carry, 2);
+  auto engine = [&] {  // as BM_BeanieControlStep_EngineWithSensitivityAsInAFlow
+    ChordMatrix<Dims<P>::unknowns> chord = previous;
+    solve_step(b, h, s, 2, opt, z, &chord, &carry);
+    const auto dz = step_sensitivity(b, h, s, z, &chord, nullptr, &carry, 2);
+    asm volatile("" : : "r"(dz.data()) : "memory");
+  };
+  oracles::BeanieStepSensitivity dz;
+  auto hand = [&] {
+    const auto zz = oracles::beanie_control_analytic_step(b, s, h, dz);
+    asm volatile("" : : "r"(&zz), "r"(&dz) : "memory");
+  };
+  const auto [te, th] = alternated_minima(engine, hand, 20000);
+  std::printf("beanie control step (paper scheme) with sensitivity: engine %.0f ns, hand-written %.0f ns, ratio %.2f\n",
+              te, th, te / th);
+}
+
+}  // namespace
+
+int main() {
+  electron_galerkin_flow();
+  beanie_paper_step();
+  return 0;
+}
