@@ -6,12 +6,14 @@
 #include <lpshoot/problems/beanie_bvp.hpp>
 #include <lpshoot/problems/electron_bvp.hpp>
 
+#include "electron_cases.hpp"
 #include "oracles/galerkin_electron.hpp"
 
 #include <benchmark/benchmark.h>
 
 using namespace lpshoot;
 using namespace lpshoot::problems;
+using lpshoot::bench::electron_start;
 
 namespace {
 
@@ -29,13 +31,6 @@ Interval<BeanieGalerkin<S>, double> beanie_start(const BeanieModel& model) {
   return iv;
 }
 
-template <int S>
-Interval<ElectronGalerkin<S>, double> electron_start(const ElectronModel& model) {
-  ElectronBoundary a, b;
-  a.position = {1, 0, 0.5}, a.velocity = {0, 1, 0}, b.position = {0, 1, -0.5}, b.velocity = {-1, 0, 0.2};
-  const auto bvp = electron_galerkin_bvp<S>(model, 2.0, 200, a, b);
-  return electron_galerkin_guess<S>(bvp, a, b).trajectory.intervals[0];
-}
 
 template <class Sch>
 void step(benchmark::State& st, const typename Sch::Model& model, const Interval<Sch, double>& start, bool sensitivity) {

@@ -9,8 +9,8 @@
 //     flow" loop: carried window Hessians, the chord matrix), against the hand-written step
 //     with its tangent-linear sensitivity (tests/oracles/analytic_steps.cpp).
 //   ./build/bench/bench_ratios
-#include <lpshoot/problems/electron_bvp.hpp>
-
+#include "beanie_cases.hpp"
+#include "electron_cases.hpp"
 #include "oracles/analytic_steps.hpp"
 #include "oracles/galerkin_electron.hpp"
 
@@ -46,10 +46,7 @@ void electron_galerkin_flow() {
   constexpr double h = 0.01;
   constexpr int steps = 200;
   const ElectronModel m = model_of(Electron{});
-  ElectronBoundary a, b;
-  a.position = {1, 0, 0.5}, a.velocity = {0, 1, 0}, b.position = {0, 1, -0.5}, b.velocity = {-1, 0, 0.2};
-  const auto bvp = electron_galerkin_bvp<3>(m, 2.0, 200, a, b);
-  const auto start = electron_galerkin_guess<3>(bvp, a, b).trajectory.intervals[0];
+  const auto start = bench::electron_start<3>(m);
   const GalerkinFlow<Sch> flow(m, h);
   const Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(Sch::state, Sch::state);
   auto engine = [&] {
@@ -80,21 +77,11 @@ void electron_galerkin_flow() {
               te / steps, th / steps, te / th);
 }
 
-FlowState<BeanieControl> beanie_state(const BeanieControl& b, double h) {  // bench_step's
-  FlowState<BeanieControl> s;
-  for (int i = 0; i < 4; ++i) s.p[i] = Vec<double, 1>(0.5 + 0.8 * i * h - 0.25 * (i * h) * (i * h));
-  s.g[0] = {0.6 * h, Eigen::Vector2d(0.8 * h, -0.3 * h)};
-  for (int i = 1; i < 3; ++i) s.g[i] = b.next_increment(s.g[i - 1], s.p[i](0) - s.p[i - 1](0));
-  s.lam = {Eigen::Vector3d(0.3, -0.2, 0.1), Eigen::Vector3d(0.302, -0.199, 0.101)};
-  return s;
-}
-
 void beanie_paper_step() {
   using P = BeanieControl;
-  BeanieControl b;
-  b.par = {1.0, 1.0, 0.5, 1.0};
+  const BeanieControl b = bench::beanie_control();
   const double h = 0.01;
-  const auto s = beanie_state(b, h);
+  const auto s = bench::beanie_state(b, h);
   const NewtonOptions opt;
   StepUnknowns<P> z;
   WindowHessianCarry<P> carry;

@@ -2,6 +2,7 @@
 // Newton with the exact Jacobian) against a hand-written analytic step of the same scheme
 // (tests/oracles, which the tests also check against the engine).
 //   ./build/bench/bench_step --benchmark_repetitions=7 --benchmark_report_aggregates_only=true
+#include "beanie_cases.hpp"
 #include "oracles/analytic_steps.hpp"
 
 #include <benchmark/benchmark.h>
@@ -9,23 +10,9 @@
 using namespace lpshoot;
 using problems::BeanieControl;
 using problems::Electron;
+using bench::beanie_state;
 
 namespace {
-FlowState<BeanieControl> beanie_state(const BeanieControl& b, double h) {
-  FlowState<BeanieControl> s;
-  for (int i = 0; i < 4; ++i) s.p[i] = Vec<double, 1>(0.5 + 0.8 * i * h - 0.25 * (i * h) * (i * h));
-  s.g[0] = {0.6 * h, Eigen::Vector2d(0.8 * h, -0.3 * h)};
-  for (int i = 1; i < 3; ++i) s.g[i] = b.next_increment(s.g[i - 1], s.p[i](0) - s.p[i - 1](0));
-  s.lam = {Eigen::Vector3d(0.3, -0.2, 0.1), Eigen::Vector3d(0.302, -0.199, 0.101)};
-  return s;
-}
-
-BeanieControl beanie() {
-  BeanieControl b;
-  b.par = {1.0, 1.0, 0.5, 1.0};
-  return b;
-}
-
 FlowState<Electron> electron_state(double h) {
   FlowState<Electron> s;
   for (int i = 0; i < 4; ++i) s.p[i] = Eigen::Vector3d(1.0 + 0.1 * i * h, 0.5 * i * h, -0.2 * i * h * i * h);
@@ -34,7 +21,7 @@ FlowState<Electron> electron_state(double h) {
 }  // namespace
 
 static void BM_BeanieControlStep_Engine(benchmark::State& st) {
-  const BeanieControl b = beanie();
+  const BeanieControl b = bench::beanie_control();
   const double h = 0.01;
   const auto s = beanie_state(b, h);
   const NewtonOptions opt;
@@ -48,7 +35,7 @@ static void BM_BeanieControlStep_Engine(benchmark::State& st) {
 BENCHMARK(BM_BeanieControlStep_Engine);
 
 static void BM_BeanieControlStep_Analytic(benchmark::State& st) {
-  const BeanieControl b = beanie();
+  const BeanieControl b = bench::beanie_control();
   const double h = 0.01;
   const auto s = beanie_state(b, h);
   for (auto _ : st) {
@@ -59,7 +46,7 @@ static void BM_BeanieControlStep_Analytic(benchmark::State& st) {
 BENCHMARK(BM_BeanieControlStep_Analytic);
 
 static void BM_BeanieControlStep_EngineWithSensitivity(benchmark::State& st) {
-  const BeanieControl b = beanie();
+  const BeanieControl b = bench::beanie_control();
   const double h = 0.01;
   const auto s = beanie_state(b, h);
   const NewtonOptions opt;
@@ -95,7 +82,7 @@ static void step_as_in_a_flow(benchmark::State& st, const P& problem, const Flow
 }
 
 static void BM_BeanieControlStep_EngineWithSensitivityAsInAFlow(benchmark::State& st) {
-  const BeanieControl b = beanie();
+  const BeanieControl b = bench::beanie_control();
   step_as_in_a_flow(st, b, beanie_state(b, 0.01), 0.01);
 }
 BENCHMARK(BM_BeanieControlStep_EngineWithSensitivityAsInAFlow);
@@ -104,7 +91,7 @@ BENCHMARK(BM_BeanieControlStep_EngineWithSensitivityAsInAFlow);
 // step's Newton starts on the previous step's matrix, whose chord steps contract as the matrix
 // changes from step to step (the loop above reuses the same step's: exact).
 static void BM_BeanieControlFlowWithSensitivity(benchmark::State& st) {
-  const BeanieControl b = beanie();
+  const BeanieControl b = bench::beanie_control();
   const double h = 0.01;
   const int N = 200;
   const DiscreteFlow<BeanieControl> flow(b, h);
@@ -124,7 +111,7 @@ BENCHMARK(BM_BeanieControlFlowWithSensitivity);
 
 // The hand-written tangent-linear step (tests/oracles/analytic_steps.cpp): value and dz/d(state).
 static void BM_BeanieControlStep_AnalyticWithSensitivity(benchmark::State& st) {
-  const BeanieControl b = beanie();
+  const BeanieControl b = bench::beanie_control();
   const double h = 0.01;
   const auto s = beanie_state(b, h);
   oracles::BeanieStepSensitivity dz;
@@ -141,14 +128,14 @@ BENCHMARK(BM_BeanieControlStep_AnalyticWithSensitivity);
 using DerivedBeanie = PaperWindows<problems::BeanieModel>;
 
 static FlowState<DerivedBeanie> derived_beanie_state(double h) {
-  const auto s = beanie_state(beanie(), h);
+  const auto s = beanie_state(bench::beanie_control(), h);
   FlowState<DerivedBeanie> d;
   d.p = s.p, d.g = s.g, d.lam = s.lam;
   return d;
 }
 
 static void BM_BeanieDerivedWindowsStep_Engine(benchmark::State& st) {
-  const DerivedBeanie b{problems::BeanieModel{beanie().par}};
+  const DerivedBeanie b{problems::BeanieModel{bench::beanie_control().par}};
   const double h = 0.01;
   const auto s = derived_beanie_state(h);
   const NewtonOptions opt;
@@ -162,7 +149,7 @@ static void BM_BeanieDerivedWindowsStep_Engine(benchmark::State& st) {
 BENCHMARK(BM_BeanieDerivedWindowsStep_Engine);
 
 static void BM_BeanieDerivedWindowsStep_EngineWithSensitivity(benchmark::State& st) {
-  const DerivedBeanie b{problems::BeanieModel{beanie().par}};
+  const DerivedBeanie b{problems::BeanieModel{bench::beanie_control().par}};
   const double h = 0.01;
   const auto s = derived_beanie_state(h);
   const NewtonOptions opt;
@@ -176,7 +163,7 @@ static void BM_BeanieDerivedWindowsStep_EngineWithSensitivity(benchmark::State& 
 BENCHMARK(BM_BeanieDerivedWindowsStep_EngineWithSensitivity);
 
 static void BM_BeanieDerivedWindowsStep_EngineWithSensitivityAsInAFlow(benchmark::State& st) {
-  const DerivedBeanie b{problems::BeanieModel{beanie().par}};
+  const DerivedBeanie b{problems::BeanieModel{bench::beanie_control().par}};
   step_as_in_a_flow(st, b, derived_beanie_state(0.01), 0.01);
 }
 BENCHMARK(BM_BeanieDerivedWindowsStep_EngineWithSensitivityAsInAFlow);
