@@ -11,6 +11,7 @@
 //   ./build/bench/bench_ratios
 #include "beanie_cases.hpp"
 #include "electron_cases.hpp"
+#include "step_as_in_a_flow.hpp"
 #include "oracles/analytic_steps.hpp"
 #include "oracles/galerkin_electron.hpp"
 
@@ -82,16 +83,9 @@ void beanie_paper_step() {
   const BeanieControl b = bench::beanie_control();
   const double h = 0.01;
   const auto s = bench::beanie_state(b, h);
-  const NewtonOptions opt;
-  StepUnknowns<P> z;
-  WindowHessianCarry<P> carry;
-  ChordMatrix<Dims<P>::unknowns> previous;
-  solve_step(b, h, s, 2, opt, z);
-  step_sensitivity(b, h, s, z, &previous, nullptr, &carry, 2);
+  bench::StepAsInAFlow<P> step(b, s, h);
   auto engine = [&] {  // as BM_BeanieControlStep_EngineWithSensitivityAsInAFlow
-    ChordMatrix<Dims<P>::unknowns> chord = previous;
-    solve_step(b, h, s, 2, opt, z, &chord, &carry);
-    const auto dz = step_sensitivity(b, h, s, z, &chord, nullptr, &carry, 2);
+    const auto dz = step();
     asm volatile("" : : "r"(dz.data()) : "memory");
   };
   oracles::BeanieStepSensitivity dz;

@@ -3,6 +3,7 @@
 // (tests/oracles, which the tests also check against the engine).
 //   ./build/bench/bench_step --benchmark_repetitions=7 --benchmark_report_aggregates_only=true
 #include "beanie_cases.hpp"
+#include "step_as_in_a_flow.hpp"
 #include "oracles/analytic_steps.hpp"
 
 #include <benchmark/benchmark.h>
@@ -59,23 +60,13 @@ static void BM_BeanieControlStep_EngineWithSensitivity(benchmark::State& st) {
 }
 BENCHMARK(BM_BeanieControlStep_EngineWithSensitivity);
 
-// As a flow's steps run it: windows a_{n-k} .. a_{n-1}'s Hessians carried from the previous
-// steps (step_window_hessian.hpp), a_n's computed; Newton starts with chord iterations on the
-// previous step's factored matrix (newton.hpp), here the same step's; the part of E_n from
-// a_{n-k} .. a_{n-1} comes from their carried gradients, as DiscreteFlow::run passes the carry.
+// As a flow's steps run it (step_as_in_a_flow.hpp).
 template <class P>
 static void step_as_in_a_flow(benchmark::State& st, const P& problem, const FlowState<P>& s, double h) {
-  const NewtonOptions opt;
-  StepUnknowns<P> z;
-  WindowHessianCarry<P> carry;
-  ChordMatrix<Dims<P>::unknowns> previous;
-  solve_step(problem, h, s, 2, opt, z);
-  step_sensitivity(problem, h, s, z, &previous, nullptr, &carry, 2);
+  bench::StepAsInAFlow<P> step(problem, s, h);
   int iterations = 0;
   for (auto _ : st) {
-    ChordMatrix<Dims<P>::unknowns> chord = previous;
-    iterations = solve_step(problem, h, s, 2, opt, z, &chord, &carry).iterations;
-    auto dz = step_sensitivity(problem, h, s, z, &chord, nullptr, &carry, 2);
+    auto dz = step(&iterations);
     benchmark::DoNotOptimize(dz);
   }
   st.counters["newton_iterations"] = iterations;
