@@ -69,6 +69,20 @@ Vec<double, IntervalDerivatives<Sch>::ny> flat_coordinates_of(const Interval<Sch
   return y;
 }
 
+// An interval's tangent coordinates without a group, (x, v, X2, V1, bubbles, λ): the state's
+// layout (galerkin.hpp offsets) and IntervalDerivatives' (y, λ).
+template <class Sch>
+Vec<double, Sch::state> flat_interval_coordinates(const Interval<Sch, double>& iv) {
+  static_assert(Sch::d == 0 && IntervalDerivatives<Sch>::ne == Sch::state, "plain coordinates only without a group");
+  Vec<double, Sch::state> c;
+  c.template segment<Sch::r>(Sch::x_off) = iv.x;
+  c.template segment<Sch::r>(Sch::v_off) = iv.v;
+  c.template segment<Sch::r>(Sch::X2_off) = iv.X2;
+  c.template segment<Sch::r>(Sch::V1_off) = iv.V1;
+  c.template segment<Sch::aux>(Sch::aux_off) = iv.w;
+  return c;
+}
+
 // IntervalDerivatives' gradient alone, (∂L~/∂y, C): first derivatives of φ_i in the jet's
 // 3r directions, pushed through K_i (what a step's residual needs; no Hessian).
 template <class Sch>

@@ -4,12 +4,14 @@
 #pragma once
 
 #include "degree.hpp"
+#include "galerkin_affine.hpp"
 #include "galerkin_step.hpp"
 
 #include <Eigen/LU>
 
 #include <algorithm>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace lpshoot {
@@ -113,8 +115,8 @@ class GalerkinFlow {
     // Affine steps (no group, degree.hpp) after the first start from the step map's prediction
     // z_c + dz · state (dz the step sensitivity, z_c read off the first step, solved by Newton;
     // the map is the same at every step, ℓ not depending on time) and take one correction with
-    // the first step's factored matrix: one evaluation per step. The correction is needed: the
-    // map alone is off by δ(dz) |state - state_0|, δ(dz) ~ cond(J) u |dz|.
+    // the first step's factored matrix, their residual from the constant interval Hessian
+    // (solve_mapped_affine_step, galerkin_affine.hpp): no evaluation of the model after step 1.
     ChordMatrix<nz> chord;
     ChordMatrix<nz>* const chord_used = seed || d > 0 || affine_ ? &chord : nullptr;
     NewtonOptions step_options = options_;  // chord-ended steps of a trajectory: polished (newton.hpp)
@@ -129,6 +131,7 @@ class GalerkinFlow {
     bool dz_current = false;
     Vec<double, nz> z_c;
     bool mapped = false;  // z_c is known: later steps start from the affine map
+    std::conditional_t<d == 0, AffineIntervalGradient<Sch>, bool> affine_gradient;  // set with z_c
     // With a group, later steps start from the extrapolation of the last intervals' unknowns
     // (extrapolate, quadratic from the third step): O(h³) off instead of O(h) for the last
     // interval's, about one Newton iteration fewer per step (beanie Galerkin 6, flows with
@@ -161,7 +164,7 @@ class GalerkinFlow {
       Interval<Sch, double> z;
       Vec<double, nz> predicted, from_guide;
       if constexpr (d == 0) {
-        if (mapped) predicted = z_c + dz * flat_coordinates(s);
+        if (mapped) predicted = z_c + dz * flat_interval_coordinates(s);
       }
       const bool extrapolated = d > 0 && k >= 2;
       if (extrapolated) predicted = extrapolate(k >= 3 ? &earlier : nullptr, before, s);
@@ -185,9 +188,12 @@ class GalerkinFlow {
         step.status = StepStatus::Converged;
         step.predicted = true;
         step.condition = condition;
+      } else if (mapped) {
+        if constexpr (d == 0)
+          step = solve_mapped_affine_step<Sch>(affine_gradient, chord, h_, s, predicted, first_node + k, z, carry);
       } else {
-        step = solve_galerkin_step<Sch>(model_, h_, s, first_node + k, step_options, z,
-                                        mapped || use_guide ? &chord : chord_used, carry_used, start_from, mapped);
+        step = solve_galerkin_step<Sch>(model_, h_, s, first_node + k, step_options, z, use_guide ? &chord : chord_used,
+                                        carry_used, start_from);
         // Without sensitivities, a step that ended at its noise tells the next ones its size
         // (NewtonOptions::noise_floor): their chord steps end once they are well within it instead
         // of sampling it (beanie Galerkin 4 at h = 2e-5: 2.7 -> 2.0 iterations per step, and
@@ -233,7 +239,13 @@ class GalerkinFlow {
         if (record && seed) out.memo.push_back({dz, chord});
         if constexpr (d == 0) {
           if (affine_ && !mapped) {
-            z_c = flat_coordinates(z).template tail<nz>() - dz * flat_coordinates(s);
+            z_c = flat_interval_coordinates(z).template tail<nz>() - dz * flat_interval_coordinates(s);
+            if (!carry.valid) {  // interval 1's derivatives (the carry holds them after step 1)
+              carry.interval = flat_interval_derivatives<Sch>(model_, z, h_);
+              carry.valid = true;
+            }
+            affine_gradient.reference = carry.interval;
+            affine_gradient.at = flat_interval_coordinates(z);
             mapped = true;
           }
         }
@@ -344,18 +356,6 @@ class GalerkinFlow {
     }
     p.template tail<Sch::aux>() = z.w;
     return p;
-  }
-
-  // An interval's tangent coordinates without a group: (x, v, X2, V1, local variables).
-  static Vec<double, Sch::state> flat_coordinates(const Interval<Sch, double>& iv) {
-    static_assert(Sch::d == 0, "plain coordinates only without a group");
-    Vec<double, Sch::state> c;
-    c.template segment<Sch::r>(Sch::x_off) = iv.x;
-    c.template segment<Sch::r>(Sch::v_off) = iv.v;
-    c.template segment<Sch::r>(Sch::X2_off) = iv.X2;
-    c.template segment<Sch::r>(Sch::V1_off) = iv.V1;
-    c.template segment<Sch::aux>(Sch::aux_off) = iv.w;
-    return c;
   }
 
   Model model_;

@@ -200,13 +200,11 @@ void evaluate_galerkin_step(const typename Sch::Model& model, double h, const In
   }
 }
 
-// F at z given the state's part of E_n (`fixed`). Without a group, `right_gradient` (if given)
-// receives interval n's gradient (∂L~/∂y, C) (galerkin_flat.hpp), from which F was formed.
+// F at z given the state's part of E_n (`fixed`).
 template <class Sch>
 Vec<double, Sch::unknowns> galerkin_step_residual(const typename Sch::Model& model, double h,
                                                   const Interval<Sch, double>& state, const Interval<Sch, double>& z,
-                                                  const Vec<double, Sch::variation>& fixed,
-                                                  Vec<double, IntervalDerivatives<Sch>::ne>* right_gradient = nullptr) {
+                                                  const Vec<double, Sch::variation>& fixed) {
   constexpr int nv = Sch::variation, na = Sch::aux;
   Interval<Sch, double> left, right;
   galerkin_step_block(state, z, false, h, left, right);
@@ -215,15 +213,12 @@ Vec<double, Sch::unknowns> galerkin_step_residual(const typename Sch::Model& mod
     const Vec<double, IntervalDerivatives<Sch>::ne> g = flat_interval_gradient<Sch>(model, right, h);
     F = flat_right_rows<Sch>(g, h);
     F.template head<nv>() += fixed;
-    if (right_gradient) *right_gradient = g;
   } else if constexpr (chains_interval_derivatives<Sch>) {  // (∂L~/∂y, C) by the chain rule, mapped to the rows
-    (void)right_gradient;
     using G = typename Sch::Group;
     const Vec<double, IntervalDerivatives<Sch>::ne> g = group_interval_gradient_chained<Sch>(model, right, h);
     F.noalias() = (1.0 / h) * group_right_map_times<Sch, 1>(h, G::Ad(G::inverse(right.W)), g);
     F.template head<nv>() += fixed;
   } else {
-    (void)right_gradient;
     Vec<double, nv> E;
     Vec<double, na> R;
     right_interval_rows<Sch>(model, right, h, E, R);
@@ -293,18 +288,15 @@ double relative_size(const Vec<double, Sch::unknowns>& dz, const Interval<Sch, d
 // n-1's unknowns", or `predictor` (unknowns' layout, ζ: W = W_{n-1} exp(h ζ)); on return z is
 // interval n (its base node included).
 // `chord`: a flow's factored step matrix, for chord iterations (newton_solve).
-// `carry`: the state's derivatives, when the flow has them (its part of E_n is read off them).
-// With `affine` (the step equations are affine and `chord` is their matrix, newton_solve) and
-// no group, the carry is moved on to interval n: its gradient is the one of the residual
-// evaluation plus the constant Hessian times the correction that followed (∇L~ is affine in
-// z), so the next step evaluates interval n's L~ once instead of twice. Otherwise the carry is
-// left for galerkin_step_sensitivity to update, or invalidated when it cannot be.
+// `carry`: the state's derivatives, when the flow has them (its part of E_n is read off them);
+// left for galerkin_step_sensitivity to move on to interval n. An affine flow's steps after the
+// first: solve_mapped_affine_step (galerkin_affine.hpp).
 template <class Sch>
 StepReport solve_galerkin_step(const typename Sch::Model& model, double h, const Interval<Sch, double>& state, int n,
                                const NewtonOptions& opt, Interval<Sch, double>& z,
                                ChordMatrix<Sch::unknowns>* chord = nullptr, StepCarry<Sch>* carry = nullptr,
-                               const Vec<double, Sch::unknowns>* predictor = nullptr, bool affine = false) {
-  constexpr int r = Sch::r, d = Sch::d, nz = Sch::unknowns, nv = Sch::variation;
+                               const Vec<double, Sch::unknowns>* predictor = nullptr) {
+  constexpr int nz = Sch::unknowns, nv = Sch::variation;
   z = galerkin_step_start<Sch>(state, h, predictor);
   Vec<double, nv> fixed;
   if constexpr (Sch::d == 0) {
@@ -322,37 +314,14 @@ StepReport solve_galerkin_step(const typename Sch::Model& model, double h, const
     rep.message = "step n=" + std::to_string(n) + ": the step equations evaluated to a non-finite number";
     return rep;
   }
-  // Interval n's gradient at the last residual evaluation and the corrections since (d = 0).
-  constexpr int ne = IntervalDerivatives<Sch>::ne;
-  Vec<double, ne> g_right;
-  Vec<double, nz> moved = Vec<double, nz>::Zero();
-  bool have_gradient = false;
-  const StepReport rep = newton_solve<nz>(
+  return newton_solve<nz>(
       n, opt,
       [&](Vec<double, nz>& F, Eigen::Matrix<double, nz, nz>& J) {
         evaluate_galerkin_step<Sch, nz>(model, h, state, z, false, &fixed, F, J);
-        have_gradient = false;
       },
-      [&](Vec<double, nz>& F) {
-        F = galerkin_step_residual<Sch>(model, h, state, z, fixed, d == 0 ? &g_right : nullptr);
-        moved.setZero();
-        have_gradient = d == 0;
-      },
-      [&](const Vec<double, nz>& dz) {
-        apply_galerkin_correction<Sch>(z, dz, h);
-        moved += dz;
-      },
-      [&] { return unknowns_magnitude<Sch>(z); },
-      chord, affine);
-  if constexpr (d == 0) {
-    if (affine && carry && carry->valid) {
-      if (rep.status == StepStatus::Converged && have_gradient)  // unknowns: interval coordinates 2r ..
-        carry->interval.gradient = g_right + carry->interval.hessian.template rightCols<ne - 2 * r>() * moved;
-      else
-        carry->valid = false;
-    }
-  }
-  return rep;
+      [&](Vec<double, nz>& F) { F = galerkin_step_residual<Sch>(model, h, state, z, fixed); },
+      [&](const Vec<double, nz>& dz) { apply_galerkin_correction<Sch>(z, dz, h); },
+      [&] { return unknowns_magnitude<Sch>(z); }, chord);
 }
 
 // Confirms a step that newton_solve ended on a prediction (StepReport::predicted), from the
