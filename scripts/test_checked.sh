@@ -11,11 +11,12 @@ export CCACHE_BASEDIR="$PWD"
 # made the sanitized objects ~1.35x slower to compile (tests/test_momentum.cpp: 65 s against 48 s).
 cmake -S . -B build-checked -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" \
   -DLPSHOOT_SANITIZE=address,undefined -DLPSHOOT_BUILD_BENCH=OFF >/dev/null
+jobs=$(bash scripts/jobs.sh)
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 if [ "${1:-}" = "--all" ]; then
-  cmake --build build-checked -j "${LPSHOOT_JOBS:-2}"
-  cd build-checked && ctest --output-on-failure -j "${LPSHOOT_JOBS:-2}" --timeout 1800
+  cmake --build build-checked -j "$jobs"
+  cd build-checked && ctest --output-on-failure -j "$jobs" --timeout 1800
 else
-  cmake --build build-checked -j "${LPSHOOT_JOBS:-2}" --target lpshoot_core_tests
-  cd build-checked && ctest --output-on-failure -j "${LPSHOOT_JOBS:-2}" -L core --timeout 1800
+  cmake --build build-checked -j "$jobs" --target lpshoot_core_tests
+  cd build-checked && ctest --output-on-failure -j "$jobs" -L core --timeout 1800
 fi
