@@ -25,14 +25,19 @@ namespace lpshoot {
 template <int N>
 struct Hess {
   static constexpr int packed = N * (N + 1) / 2;
-  double v = 0;
-  std::array<double, N> g{};
-  std::array<double, packed> H{};
+  double v;
+  std::array<double, N> g;
+  std::array<double, packed> H;
 
-  Hess() = default;
-  Hess(double value) : v(value) {}  // NOLINT: implicit, a constant
+  // Hess() and constants are zero in every derivative. The arithmetic below writes every entry
+  // of its result, which it constructs Uninitialized: zeroing the 440 bytes of a Hess<9> first
+  // showed as `rep stos` in the paper scheme's window Hessians (bench/RESULTS.md).
+  struct Uninitialized {};
+  Hess() : v(0), g{}, H{} {}
+  explicit Hess(Uninitialized) {}
+  Hess(double value) : v(value), g{}, H{} {}  // NOLINT: implicit, a constant
   template <class A, std::enable_if_t<std::is_arithmetic_v<A> && !std::is_same_v<A, double>, int> = 0>
-  Hess(A value) : v(double(value)) {}  // NOLINT
+  Hess(A value) : v(double(value)), g{}, H{} {}  // NOLINT
 
   // g copied whole from a unit vector, as Dual::variable (dual.hpp: a store-forwarding stall).
   static Hess variable(double x, int i) {
@@ -51,28 +56,28 @@ struct Hess {
 
   friend Hess operator+(const Hess& a) { return a; }
   friend Hess operator-(const Hess& a) {
-    Hess r;
+    Hess r{Uninitialized{}};
     r.v = -a.v;
     for (int i = 0; i < N; ++i) r.g[i] = -a.g[i];
     for (int k = 0; k < packed; ++k) r.H[k] = -a.H[k];
     return r;
   }
   friend Hess operator+(const Hess& a, const Hess& b) {
-    Hess r;
+    Hess r{Uninitialized{}};
     r.v = a.v + b.v;
     for (int i = 0; i < N; ++i) r.g[i] = a.g[i] + b.g[i];
     for (int k = 0; k < packed; ++k) r.H[k] = a.H[k] + b.H[k];
     return r;
   }
   friend Hess operator-(const Hess& a, const Hess& b) {
-    Hess r;
+    Hess r{Uninitialized{}};
     r.v = a.v - b.v;
     for (int i = 0; i < N; ++i) r.g[i] = a.g[i] - b.g[i];
     for (int k = 0; k < packed; ++k) r.H[k] = a.H[k] - b.H[k];
     return r;
   }
   friend Hess operator*(const Hess& a, const Hess& b) {
-    Hess r;
+    Hess r{Uninitialized{}};
     r.v = a.v * b.v;
     for (int i = 0; i < N; ++i) r.g[i] = a.g[i] * b.v + a.v * b.g[i];
     int k = 0;
@@ -110,7 +115,7 @@ struct Hess {
 
   // f(a) from f, f', f'' at a's value.
   friend Hess chain(const Hess& a, double f, double df, double ddf) {
-    Hess r;
+    Hess r{Uninitialized{}};
     r.v = f;
     for (int i = 0; i < N; ++i) r.g[i] = df * a.g[i];
     int k = 0;
@@ -171,7 +176,7 @@ Hess<N> atan2(const Hess<N>& y, const Hess<N>& x) {
   const double r2 = x.v * x.v + y.v * y.v, r4 = r2 * r2;
   const double fy = x.v / r2, fx = -y.v / r2;
   const double fyy = -2.0 * x.v * y.v / r4, fxx = -fyy, fxy = (y.v * y.v - x.v * x.v) / r4;
-  Hess<N> r;
+  Hess<N> r{typename Hess<N>::Uninitialized{}};
   r.v = std::atan2(y.v, x.v);
   for (int i = 0; i < N; ++i) r.g[i] = fy * y.g[i] + fx * x.g[i];
   int k = 0;
