@@ -5,6 +5,9 @@
 // neither. Pairs:
 //   - the electron Galerkin 4 flow, 200 steps, 12 state directions seeded, per step, against
 //     the hand-written flow of bench_galerkin_step (the step map formed once per flow);
+//   - the electron flow of the paper scheme, 200 steps, 12 state directions seeded, per step,
+//     against the hand-written flow (its closed-form step map formed once per flow,
+//     tests/oracles/analytic_steps.cpp), which is also its sensitivity;
 //   - the beanie control step of the paper scheme as a flow takes it (bench_step's "as in a
 //     flow" loop: carried window Hessians, the chord matrix), against the hand-written step
 //     with its tangent-linear sensitivity (tests/oracles/analytic_steps.cpp).
@@ -78,6 +81,44 @@ void electron_galerkin_flow() {
               te / steps, th / steps, te / th);
 }
 
+void electron_paper_flow() {
+  const Electron e;
+  constexpr double h = 0.01;
+  constexpr int N = 200, steps = N - 3;  // a flow over N intervals makes N - 2k + 1 steps
+  FlowState<Electron> s;
+  const Eigen::Vector3d x0(1, 0, 0.5), v0(0, 1, -0.2), a0(0.3, -0.1, 0.2);
+  for (int i = 0; i < 4; ++i) s.p[i] = x0 + i * h * v0 + 0.5 * (i * h) * (i * h) * a0;
+  const DiscreteFlow<Electron> flow(e, h);
+  const Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(12, 12);
+  auto engine = [&] {
+    const auto r = flow.run(s, N, &seed);
+    if (!r.report.ok()) std::printf("electron paper flow failed: %s\n", r.report.message.c_str());
+    asm volatile("" : : "r"(r.sensitivity.data()) : "memory");
+  };
+  Eigen::Matrix<double, 12, 1> c0;
+  c0 << s.p[0], s.p[1], s.p[2], s.p[3];
+  auto hand = [&] {
+    const Eigen::Matrix<double, 3, 12> Phi = oracles::electron_paper_step_map(e, h);
+    Eigen::Matrix<double, 12, 1> c = c0, cn;
+    Eigen::Matrix<double, 12, 12> S = Eigen::Matrix<double, 12, 12>::Identity(), next;
+    std::vector<Eigen::Vector3d> nodes;  // the trajectory, as the engine keeps it
+    nodes.reserve(N + 1);
+    for (int k = 0; k < steps; ++k) {
+      cn.head<9>() = c.tail<9>();
+      cn.tail<3>().noalias() = Phi * c;
+      c.swap(cn);
+      nodes.push_back(c.tail<3>());
+      next.topRows<9>() = S.bottomRows<9>();
+      next.bottomRows<3>().noalias() = Phi.lazyProduct(S);
+      S.swap(next);
+    }
+    asm volatile("" : : "r"(c.data()), "r"(S.data()), "r"(nodes.data()) : "memory");
+  };
+  const auto [te, th] = alternated_minima(engine, hand, 500);
+  std::printf("electron paper flow with sensitivities, per step: engine %.0f ns, hand-written %.0f ns, ratio %.2f\n",
+              te / steps, th / steps, te / th);
+}
+
 void beanie_paper_step() {
   using P = BeanieControl;
   const BeanieControl b = bench::beanie_control();
@@ -102,6 +143,7 @@ void beanie_paper_step() {
 
 int main() {
   electron_galerkin_flow();
+  electron_paper_flow();
   beanie_paper_step();
   return 0;
 }

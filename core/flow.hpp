@@ -5,12 +5,14 @@
 #pragma once
 
 #include "degree.hpp"
+#include "paper_affine.hpp"
 #include "step_solve.hpp"
 
 #include <Eigen/Core>
 
 #include <algorithm>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace lpshoot {
@@ -161,9 +163,20 @@ class DiscreteFlow {
     // control at h = 0.01: three residuals per step before, two now.
     NewtonOptions step_options = options_;
     step_options.end_on_prediction = seed && !affine_ && uses_window_hessians<P>();
+    // An affine flow without a group takes its steps after the first from the constant window
+    // Hessian of step k's windows (paper_affine.hpp): no evaluation of the problem after step k.
+    constexpr bool can_map = d == 0 && uses_window_hessians<P>() && !keeps_low_parts<P>();
+    const bool maps = can_map && affine_;
+    bool mapped = false;
+    std::conditional_t<can_map, AffineWindowGradient<P>, bool> affine_gradient{};
+    WindowHessianCarry<P>* const carry_used = seed || maps ? &windows : nullptr;
     for (int n = k; n <= N - k; ++n) {
       StepUnknowns<P> z;
-      const StepReport step = solve_step(problem_, h_, s, n, step_options, z, chord_used, seed ? &windows : nullptr);
+      StepReport step;
+      if constexpr (can_map) {
+        if (mapped) step = solve_mapped_affine_paper_step(affine_gradient, chord, s, n, z, windows);
+      }
+      if (!mapped) step = solve_step(problem_, h_, s, n, step_options, z, chord_used, carry_used);
       if (!rep.add(step)) return out;
       // W of the state's first node (it does not depend on z): g_first's update, and with the
       // group seeded, its sensitivity's Jacobian JW.
@@ -223,6 +236,13 @@ class DiscreteFlow {
           }
         }
         out.sensitivity.swap(next);
+      }
+      if constexpr (can_map) {
+        if (maps && !mapped) {  // step k's windows and their Hessian (with a seed, computed above)
+          if (!seed) step_sensitivity(problem_, h_, s, z, &chord, nullptr, &windows, n);
+          affine_gradient.set(windows.of(n), s, z);
+          mapped = true;
+        }
       }
       out.g_first = G::compose(out.g_first, W_first);
       // Shift the state and store the new unknowns.

@@ -72,6 +72,25 @@ Eigen::Vector3d electron_analytic_step(const Electron& e, const std::array<Eigen
   return (h * h / e.mass) * (U2 - known) + 2 * x[3] - x[2];
 }
 
+// With X = [B×], β = e/c, a = m/h²: U(x_i, x_{i+1}, x_{i+2}) = C0 x_i + C1 x_{i+1} + C2 x_{i+2},
+// C0 = (a + 2κ) I - (β/h) X, C1 = -2a I + (β/h) X, C2 = a I; the right-hand side is
+// P U_{n-1} - Q U_{n-2} with P = (2m/h) I + β X, Q = (m/h) I; "known" = 2κ x_n + (β/h) X (x_{n+1} - x_n).
+Eigen::Matrix<double, 3, 12> electron_paper_step_map(const Electron& e, double h) {
+  using Eigen::Matrix3d;
+  const Matrix3d I = Matrix3d::Identity(), X = cross_matrix(e.B);
+  const double a = e.mass / (h * h), beta = e.e_over_c, kappa = e.potential;
+  const Matrix3d C0 = (a + 2 * kappa) * I - (beta / h) * X, C1 = -2 * a * I + (beta / h) * X, C2 = a * I;
+  const Matrix3d P = (2 * e.mass / h) * I + beta * X, Q = (e.mass / h) * I;
+  const Matrix3d A_inverse = ((e.mass / h + 2 * kappa * h) * I + beta * X).inverse();
+  const double s = h * h / e.mass;
+  Eigen::Matrix<double, 3, 12> Phi;
+  Phi.block<3, 3>(0, 0) = s * A_inverse * (-Q * C0);
+  Phi.block<3, 3>(0, 3) = s * A_inverse * (P * C0 - Q * C1);
+  Phi.block<3, 3>(0, 6) = s * (A_inverse * (P * C1 - Q * C2) - 2 * kappa * I + (beta / h) * X) - I;
+  Phi.block<3, 3>(0, 9) = s * (A_inverse * (P * C2) - (beta / h) * X) + 2 * I;
+  return Phi;
+}
+
 // Derivation (window j: ψ_j, ψ_{j+1}, ψ_{j+2}, g~_j = (ω_j, t_j), g~_{j+1}; β_j = ω_j - cΔψ_j):
 //   u_j = μ Δ²ψ_j / h^2 + V'(ψ_{j+1}),  L^_j = (h/2) u_j^2,
 //   χ_j = ((t_{j+1} - Rot(β_j) t_j)/h, (ω_{j+1} - ω_j)/h), Rot(β) = R(-β) or I - βJ.

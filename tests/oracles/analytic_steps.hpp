@@ -24,6 +24,11 @@ Eigen::Vector3d electron_analytic_residual(const Electron& e, const std::array<E
 // The electron step, solved in closed form (E_n is linear in U_n): x_{n+2} from x_{n-2} .. x_{n+1}.
 Eigen::Vector3d electron_analytic_step(const Electron& e, const std::array<Eigen::Vector3d, 4>& x, double h);
 
+// The same step as a matrix, in closed form: x_{n+2} = Φ (x_{n-2}; x_{n-1}; x_n; x_{n+1}) (the step
+// is linear and homogeneous in the nodes), and so also its sensitivity to the state. The
+// hand-written paper electron flow of bench/bench_ratios.cpp forms it once per flow.
+Eigen::Matrix<double, 3, 12> electron_paper_step_map(const Electron& e, double h);
+
 // The k = 2 beanie optimal-control step solved by hand: the η-equations give λ^n in closed form,
 // the ψ-equation gives u_n (hence ψ_{n+2}), the constraints give g~_{n+1}. See the .cpp.
 StepUnknowns<BeanieControl> beanie_control_analytic_step(const BeanieControl& b,
