@@ -95,12 +95,21 @@ struct Hess {
   friend Hess operator+(Hess a, double b) { a.v += b; return a; }
   friend Hess operator+(double a, Hess b) { b.v += a; return b; }
   friend Hess operator-(Hess a, double b) { a.v -= b; return a; }
-  friend Hess operator-(double a, const Hess& b) { return -(b - a); }
-  friend Hess operator*(Hess a, double b) {
-    a.v *= b;
-    for (double& x : a.g) x *= b;
-    for (double& x : a.H) x *= b;
-    return a;
+  friend Hess operator-(double a, const Hess& b) {
+    Hess r{Uninitialized{}};
+    r.v = a - b.v;
+    for (int i = 0; i < N; ++i) r.g[i] = -b.g[i];
+    for (int k = 0; k < packed; ++k) r.H[k] = -b.H[k];
+    return r;
+  }
+  // One pass from a into the result (a by value was a copy of a's 440 bytes, for Hess<9>, then
+  // a pass over the copy).
+  friend Hess operator*(const Hess& a, double b) {
+    Hess r{Uninitialized{}};
+    r.v = a.v * b;
+    for (int i = 0; i < N; ++i) r.g[i] = a.g[i] * b;
+    for (int k = 0; k < packed; ++k) r.H[k] = a.H[k] * b;
+    return r;
   }
   friend Hess operator*(double a, const Hess& b) { return b * a; }
   friend Hess operator/(const Hess& a, double b) { return a * (1.0 / b); }

@@ -218,6 +218,26 @@ void step_jacobian_from_windows(const P& problem, double h, const FlowState<P>& 
                                    step_column<P>, true, J);
 }
 
+// F at z from window a_n's gradient (window_gradient), given the fixed part of E_n: E_n =
+// fixed + Bᵀ g over increment n's perturbation `right` (node n at its left end; it depends on the
+// state alone for k >= 2), χ_d(a_n) from g's λ entries. step_residual's F, by the chain rule of
+// step_window_hessian.hpp instead of node n's moves carried through the perturbed increments.
+template <class P>
+Vec<double, Dims<P>::unknowns> step_residual_from_window(const P& problem, double h, const FlowState<P>& s,
+                                                         const StepUnknowns<P>& z,
+                                                         const Vec<double, Dims<P>::node>& fixed,
+                                                         const IncrementPerturbation<P>& right) {
+  using D = Dims<P>;
+  constexpr int k = D::k, m = D::m;
+  const NodeBlock<P, double> b = step_block<P, double>(s, z, false);
+  const auto g = window_gradient(problem, b.window(k), b.lam[k], h);
+  Vec<double, D::unknowns> F;
+  F.template head<D::node>() =
+      fixed + node_gradient_from_windows<P>([&](int) -> const auto& { return g; }, k, k, right, right);
+  if constexpr (m > 0) F.template tail<m>() = g.template tail<m>();
+  return F;
+}
+
 // F and ∂F/∂z at z from window a_n's Hessian (the only window that contains z), given the fixed
 // part of E_n: E_n's rows Σ Bᵀ g and Bᵀ H + Σ g C (step_window_hessian.hpp) over window a_n
 // alone, χ_d(a_n) and its derivatives from the Hessian's λ rows. One pass in Hess arithmetic
@@ -240,7 +260,8 @@ void step_matrix_from_window(const P& problem, double h, const FlowState<P>& s, 
   node_derivatives_from_windows<P>(
       window_n, right, right, [](int j, int w) { const int col = step_column<P>(j, w); return col < nz ? col : -1; }, true,
       Jz, k);
-  F.template head<D::node>() = fixed + node_gradient_from_windows<P>(window_n, k, k, right, right);
+  F.template head<D::node>() =
+      fixed + node_gradient_from_windows<P>([&](int) -> const auto& { return wh.gradient; }, k, k, right, right);
   if constexpr (m > 0) F.template tail<m>() = wh.gradient.template tail<m>();
 }
 

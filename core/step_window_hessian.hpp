@@ -95,6 +95,56 @@ void window_hessian(const P& problem, const Window<P, double>& a, const Vec<doub
   out.hessian.template triangularView<Eigen::StrictlyLower>() = out.hessian.transpose();
 }
 
+// The gradient alone of L~(a) in the window's coordinates, in first-order duals (the λ entries
+// are χ_d). With the increments' perturbations B, a step's residual is Σ Bᵀ g over its windows
+// (the file comment); for window a_n this costs one pass in Dual<nw - m> over the user's L_d
+// and χ_d, where the perturbed window (node_residual) carries node n's moves through group
+// operations (beanie control: compose, exp and the connection in Dual<4>, ~2x the pass).
+template <class P>
+Vec<double, window_coordinates<P>()> window_gradient(const P& problem, const Window<P, double>& a,
+                                                     const Vec<double, P::num_constraints>& lam, double h) {
+  using G = typename P::Group;
+  constexpr int k = P::order, r = P::shape_dim, d = G::dim, m = P::num_constraints, nw = window_coordinates<P>();
+  constexpr int nx = nw - m;
+  using T = Dual<double, nx>;
+  Window<P, T> A;
+  int w = 0;
+  for (int i = 0; i <= k; ++i)
+    for (int c = 0; c < r; ++c) A.p[i](c) = T::variable(a.p[i](c), w++);
+  A.p_low = a.p_low;
+  for (int i = 0; i < k; ++i, w += d) {
+    if constexpr (has_element_scalars<G>()) {
+      // g~ exp(δ) depends on δ alone: computed in Dual<d>, placed in its d directions.
+      using TD = Dual<double, d>;
+      typename G::template Tangent<TD> delta;
+      for (int c = 0; c < d; ++c) delta(c) = TD::variable(0.0, c);
+      auto moved = G::compose(G::template cast<TD>(a.g[i]), G::template exp<TD>(delta));
+      const auto from = ElementScalars<G>::of(moved);
+      const auto to = ElementScalars<G>::of(A.g[i]);
+      for (int c = 0; c < ElementScalars<G>::count; ++c) {
+        to[c]->v = from[c]->v;
+        to[c]->d.fill(0.0);
+        for (int b = 0; b < d; ++b) to[c]->d[w + b] = from[c]->d[b];
+      }
+    } else {
+      typename G::template Tangent<T> delta;
+      for (int c = 0; c < d; ++c) delta(c) = T::variable(0.0, w + c);
+      A.g[i] = G::compose(G::template cast<T>(a.g[i]), G::template exp<T>(delta));
+    }
+  }
+  T L = problem.template lagrangian<T>(A, h);
+  Vec<double, nw> out;
+  if constexpr (m > 0) {
+    const Vec<T, m> chi = problem.template constraints<T>(A, h);
+    for (int c = 0; c < m; ++c) {
+      L = L + lam(c) * chi(c);
+      out(nx + c) = chi(c).v;
+    }
+  }
+  for (int i = 0; i < nx; ++i) out(i) = L.d[i];
+  return out;
+}
+
 // An increment g~ over (p0, p1) perturbed by a move ε = (δp, η) of its right end (node_at_right)
 // or left end, as y = log(g~^{-1} g~') in ε and in its own coordinates x = (δp0, δp1, δ):
 // B = ∂y/∂ε and C[q] = ∂²y_q/∂ε∂x at 0.
@@ -228,15 +278,15 @@ const IncrementPerturbation<P>& step_increment_perturbation(const P& problem, co
 }
 
 // E_c's part from windows c-k+first .. c-k+last (c = k, the step's node): Σ_j Bᵀ g_j (the file
-// comment), from the windows' gradients.
-template <class P, class HessianOf>
-Vec<double, Dims<P>::node> node_gradient_from_windows(HessianOf&& hessian_of, int first, int last,
+// comment), from the windows' gradients (gradient_of(j)).
+template <class P, class GradientOf>
+Vec<double, Dims<P>::node> node_gradient_from_windows(GradientOf&& gradient_of, int first, int last,
                                                       const IncrementPerturbation<P>& left,
                                                       const IncrementPerturbation<P>& right) {
   constexpr int k = P::order, r = P::shape_dim, d = P::Group::dim, c = k;
   Vec<double, Dims<P>::node> E = Vec<double, Dims<P>::node>::Zero();
   for (int j = first; j <= last; ++j) {
-    const auto& g = hessian_of(j).gradient;
+    const Vec<double, window_coordinates<P>()>& g = gradient_of(j);
     E.template head<r>() += g.template segment<r>((c - j) * r);
     if constexpr (d > 0) {
       if (j <= c - 1) E.noalias() += left.B.transpose() * g.template segment<d>((k + 1) * r + (c - 1 - j) * d);

@@ -152,6 +152,53 @@ TEST(PaperFlowSteps, ConfirmedStepsSolveTheirEquationsToTheRoundingLevel) {
   }
 }
 
+// A step's residual from window a_n's gradient and increment n's perturbation (Newton's
+// residual with a group, step_residual_from_window) against the residual of the perturbed windows
+// (step_residual, forward mode through node n's moves): the same F to rounding, at solved steps
+// and away from them (z moved), for both constraint sets and for the derived beanie windows
+// (PaperWindows, with the nodes' low parts).
+TEST(PaperFlowSteps, ResidualFromTheWindowGradientIsThePerturbedWindowsResidual) {
+  auto expect_same = [](const auto& problem, const auto& start, double h, const char* name) {
+    using P = std::decay_t<decltype(problem)>;
+    const int N = 40;
+    const auto out = DiscreteFlow<P>(problem, h).run(start, N);
+    ASSERT_TRUE(out.report.ok()) << out.report.message;
+    double worst = 0, scale = 0;
+    for (int n = 2; n <= N - 2; n += 5) {
+      const FlowState<P> s = out.trajectory.state(n);
+      for (double move : {0.0, 1e-3, -0.05}) {
+        StepUnknowns<P> z;
+        z.p = out.trajectory.p[n + 2] + Vec<double, P::shape_dim>::Constant(move);
+        z.g = P::Group::compose(out.trajectory.g[n + 1],
+                                P::Group::template exp<double>(P::Group::template Tangent<double>::Constant(move)));
+        z.lam = out.trajectory.lam[n] + Vec<double, P::num_constraints>::Constant(10 * move);
+        const NodeBlock<P, double> b = step_block<P, double>(s, z, false);
+        const auto right = increment_perturbation(problem, b.p[2], b.p[3], b.g[2], false);
+        const auto fixed = step_fixed_part(problem, h, s, z);
+        const auto F = step_residual(problem, h, s, z, fixed);
+        const auto G = step_residual_from_window(problem, h, s, z, fixed, right);
+        worst = std::max(worst, (F - G).template lpNorm<Eigen::Infinity>());
+        scale = std::max(scale, F.template lpNorm<Eigen::Infinity>() + fixed.template lpNorm<Eigen::Infinity>());
+      }
+    }
+    std::printf("%s: residuals differ by %.1e (scale %.1e)\n", name, worst, scale);
+    EXPECT_LT(worst, 1e-12 * scale) << name;
+  };
+  const double h = 0.02;
+  for (auto variant : {problems::BeanieConstraints::ExactRotation, problems::BeanieConstraints::Paper}) {
+    BeanieControl b = beanie();
+    b.variant = variant;
+    expect_same(b, smooth_start(b, h), h, variant == problems::BeanieConstraints::Paper ? "paper constraints" : "exact rotation");
+  }
+  using Derived = PaperWindows<problems::BeanieModel>;
+  Derived derived;
+  derived.model.par = beanie().par;
+  FlowState<Derived> s;
+  const FlowState<BeanieControl> c = smooth_start(beanie(), h);
+  s.p = c.p, s.g = c.g, s.lam = c.lam;
+  expect_same(derived, s, h, "derived beanie windows");
+}
+
 // Nodes 3, 1, 3, 4: the extrapolated predictor of the next node is 4 (quadratic), the plain one 5
 // (linear), and E_n = ½ (z - 4)² - 2 (windows n, n-1, n-2: ½ (z - 4)² - 1, 2, 3 (3 - 4)), whose
 // root beyond the plain predictor is z = 6. With c = 4 the step matrix vanishes at the
