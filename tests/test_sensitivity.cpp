@@ -136,10 +136,15 @@ void check_step_derivatives_at(const P& problem, double h, const FlowResult<P>& 
     // E_n itself from the windows' gradients (solve_step's fixed part, here every window).
     const NodeBlock<P, double> b = step_block<P, double>(s, z, false);
     const Vec<double, D::node> E = node_gradient_from_windows<P>(
-        [&](int j) -> const WindowHessian<P>& { return carried.of(n - D::k + j); }, 0, D::k,
+        [&](int j) -> const auto& { return carried.of(n - D::k + j).gradient; }, 0, D::k,
         step_increment_perturbation(problem, b, carried, n, false), step_increment_perturbation(problem, b, carried, n, true));
     const double scale = std::max(1.0, F1.template lpNorm<Eigen::Infinity>());
     EXPECT_LT((E - F1.template head<D::node>()).template lpNorm<Eigen::Infinity>(), 1e-13 * scale);
+    // Window a_n's gradient alone, in first-order duals (Newton's residual with a group), is the
+    // gradient of its Hessian pass.
+    const auto& an = carried.of(n).gradient;
+    EXPECT_LT((window_gradient(problem, b.window(D::k), b.lam[D::k], h) - an).template lpNorm<Eigen::Infinity>(),
+              1e-14 * std::max(1.0, an.template lpNorm<Eigen::Infinity>()));
     // Newton's F and ∂F/∂z alone (solve_step), from window a_n's Hessian against nested duals.
     const Vec<double, D::node> fixed = step_fixed_part(problem, h, s, z);
     Vec<double, nz> F5, F6;
