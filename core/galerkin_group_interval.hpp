@@ -151,16 +151,16 @@ GroupCurveEnds<Sch, Hess<4 * Sch::r + 3 * Sch::d>> seeded_group_curve_ends(const
   const typename G::template Tangent<TZ> zeta_d = G::log(G::compose(G::template cast<TZ>(iv.W), G::template exp<TZ>(delta)));
   Vec<T, d> zeta, Om, O1;
   Vec<T, r> x, v, X2, V1;
-  for (int a = 0; a < d; ++a) {
-    embed(zeta(a), zeta_d(a), Sch::W_off);
-    Om(a) = T::variable(iv.Om(a), Sch::Om_off + a);
-    O1(a) = T::variable(iv.O1(a), Sch::O1_off + a);
+  for (int a = 0; a < d; ++a) {  // the vectors start at zero: seeded in place (hessian_scalar.hpp)
+    add_embedded(zeta(a), zeta_d(a), Sch::W_off);
+    make_variable_in_place(Om(a), iv.Om(a), Sch::Om_off + a);
+    make_variable_in_place(O1(a), iv.O1(a), Sch::O1_off + a);
   }
   for (int a = 0; a < r; ++a) {
-    x(a) = T::variable(iv.x(a), Sch::x_off + a);
-    v(a) = T::variable(iv.v(a), Sch::v_off + a);
-    X2(a) = T::variable(iv.X2(a), Sch::X2_off + a);
-    V1(a) = T::variable(iv.V1(a), Sch::V1_off + a);
+    make_variable_in_place(x(a), iv.x(a), Sch::x_off + a);
+    make_variable_in_place(v(a), iv.v(a), Sch::v_off + a);
+    make_variable_in_place(X2(a), iv.X2(a), Sch::X2_off + a);
+    make_variable_in_place(V1(a), iv.V1(a), Sch::V1_off + a);
   }
   // group_curve_ends_from, with ω1 = Jr(ζ)^{-1} y (y the end velocity) taken as a function of
   // its 2d arguments in Hess<2d> and composed: ζ depends on δ alone and y on a few coordinates,
@@ -213,9 +213,9 @@ Jet<typename Sch::Model, Hess<3 * Sch::r + 3 * Sch::d>> seeded_jet(const typenam
       xi2(a) = TX::variable(u(3 * r + 2 * d + a), 2 * d + a);
     }
     body_velocity_jet<G, TX>(xi0, xi1, xi2, Om, dOm);
-    for (int a = 0; a < d; ++a) {
-      embed(q.Omega(a), Om(a), 3 * r);
-      embed(q.dOmega(a), dOm(a), 3 * r);
+    for (int a = 0; a < d; ++a) {  // q's scalars start at zero
+      add_embedded(q.Omega(a), Om(a), 3 * r);
+      add_embedded(q.dOmega(a), dOm(a), 3 * r);
     }
   }
   // + 𝒜(p) p' and its time derivative: functions of (p, p', p''), the first 3r directions, run

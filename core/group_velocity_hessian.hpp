@@ -30,17 +30,6 @@ struct SeededVelocity {
   static constexpr bool available = false;
 };
 
-namespace detail {
-
-// Sets o to the seeded variable x at index i (o must be zero).
-template <int N>
-void set_variable(Hess<N>& o, double x, int i) {
-  o.v = x;
-  o.g[i] = 1.0;
-}
-
-}  // namespace detail
-
 template <int n>
 struct SeededVelocity<Rn<n>> {
   static constexpr bool available = true;
@@ -48,8 +37,8 @@ struct SeededVelocity<Rn<n>> {
   template <int N, class Index>
   static void jet(const double*, const double* x1, const double* x2, const Index& idx, Hess<N>* Om, Hess<N>* dOm) {
     for (int a = 0; a < n; ++a) {
-      detail::set_variable(Om[a], x1[a], idx(1, a));
-      detail::set_variable(dOm[a], x2[a], idx(2, a));
+      make_variable_in_place(Om[a], x1[a], idx(1, a));
+      make_variable_in_place(dOm[a], x2[a], idx(2, a));
     }
   }
 };
@@ -59,8 +48,8 @@ struct SeededVelocity<SO2> {
   static constexpr bool available = true;
   template <int N, class Index>
   static void jet(const double*, const double* x1, const double* x2, const Index& idx, Hess<N>* Om, Hess<N>* dOm) {
-    detail::set_variable(Om[0], x1[0], idx(1, 0));
-    detail::set_variable(dOm[0], x2[0], idx(2, 0));
+    make_variable_in_place(Om[0], x1[0], idx(1, 0));
+    make_variable_in_place(dOm[0], x2[0], idx(2, 0));
   }
 };
 
@@ -130,8 +119,8 @@ struct SeededVelocity<SE2> {
     add_term(P, by_w1, v1, idx(1, 0), idx(1, 1), iw, dOm[0], dOm[1]);
     add_term(B, by_w2, v, idx(0, 0), idx(0, 1), iw, dOm[0], dOm[1]);
     add_term(Bp, by_w1sq, v, idx(0, 0), idx(0, 1), iw, dOm[0], dOm[1]);
-    detail::set_variable(Om[2], w1, iw1);
-    detail::set_variable(dOm[2], w2, iw2);
+    make_variable_in_place(Om[2], w1, iw1);
+    make_variable_in_place(dOm[2], w2, iw2);
   }
 };
 

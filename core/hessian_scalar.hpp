@@ -237,7 +237,15 @@ void add_embedded(Hess<N>& e, const Hess<M>& a, int first) {
   }
 }
 
-// e = a, as in add_embedded.
+// o = Hess<N>::variable(x, i) for an o that is zero (Hess()), written in place: building the
+// variable as a temporary and copying it moves the whole scalar (440 bytes for Hess<9>) twice.
+template <int N>
+void make_variable_in_place(Hess<N>& o, double x, int i) {
+  o.v = x;
+  o.g[i] = 1.0;
+}
+
+// e = a, as in add_embedded (e = a + 0 when e is known to be zero: add_embedded alone).
 template <int N, int M>
 void embed(Hess<N>& e, const Hess<M>& a, int first) {
   e = Hess<N>();

@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <cmath>
 #include <utility>
 
 namespace lpshoot {
@@ -28,19 +29,31 @@ class SmallLU {
   using Matrix = Eigen::Matrix<double, n, n>;
   using Vector = Eigen::Matrix<double, n, 1>;
 
-  // Right-looking elimination on columns: each step is a pivot search, one row interchange and
-  // contiguous column updates below the pivot.
+  // Right-looking elimination on columns: each step is a pivot search (the first largest
+  // magnitude, as Eigen's maxCoeff), one row interchange and contiguous column updates below the
+  // pivot, on a local array.
   void compute(const Matrix& a) {
-    lu_ = a;
+    double t[n * n];  // column-major, as lu_
+    for (int i = 0; i < n * n; ++i) t[i] = a.data()[i];
     for (int k = 0; k < n; ++k) {
-      Eigen::Index p = 0;
-      lu_.col(k).tail(n - k).cwiseAbs().maxCoeff(&p);
-      pivot_[k] = k + static_cast<int>(p);
-      if (pivot_[k] != k) lu_.row(k).swap(lu_.row(pivot_[k]));
-      const int below = n - k - 1;
-      if (lu_(k, k) != 0) lu_.col(k).tail(below) /= lu_(k, k);
-      for (int j = k + 1; j < n; ++j) lu_.col(j).tail(below) -= lu_(k, j) * lu_.col(k).tail(below);
+      double* ck = t + k * n;
+      int p = k;
+      double largest = std::abs(ck[k]);
+      for (int i = k + 1; i < n; ++i)
+        if (std::abs(ck[i]) > largest) largest = std::abs(ck[i]), p = i;
+      pivot_[k] = p;
+      if (p != k)
+        for (int j = 0; j < n; ++j) std::swap(t[j * n + k], t[j * n + p]);
+      const double pivot = ck[k];
+      if (pivot != 0)
+        for (int i = k + 1; i < n; ++i) ck[i] /= pivot;
+      for (int j = k + 1; j < n; ++j) {
+        double* cj = t + j * n;
+        const double s = cj[k];
+        for (int i = k + 1; i < n; ++i) cj[i] -= s * ck[i];
+      }
     }
+    for (int i = 0; i < n * n; ++i) lu_.data()[i] = t[i];
     for (int i = 0; i < n; ++i) row_[i] = i;
     for (int k = 0; k < n; ++k) std::swap(row_[k], row_[pivot_[k]]);
   }

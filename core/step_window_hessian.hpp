@@ -54,10 +54,12 @@ void window_hessian(const P& problem, const Window<P, double>& a, const Vec<doub
   constexpr int k = P::order, r = P::shape_dim, d = G::dim, m = P::num_constraints, nw = window_coordinates<P>();
   constexpr int nx = nw - m;
   using T = Hess<nx>;
+  // A's scalars start at zero (Hess()): the variables and the increments' scalars are written in
+  // place, not built as temporaries of 440 bytes (Hess<9>) and copied.
   Window<P, T> A;
   int w = 0;
   for (int i = 0; i <= k; ++i)
-    for (int c = 0; c < r; ++c) A.p[i](c) = T::variable(a.p[i](c), w++);
+    for (int c = 0; c < r; ++c, ++w) make_variable_in_place(A.p[i](c), a.p[i](c), w);
   A.p_low = a.p_low;
   for (int i = 0; i < k; ++i, w += d) {
     if constexpr (has_element_scalars<G>()) {
@@ -68,31 +70,29 @@ void window_hessian(const P& problem, const Window<P, double>& a, const Vec<doub
       auto moved = G::compose(G::template cast<TD>(a.g[i]), G::template exp<TD>(delta));
       const auto from = ElementScalars<G>::of(moved);
       const auto to = ElementScalars<G>::of(A.g[i]);
-      for (int c = 0; c < ElementScalars<G>::count; ++c) embed(*to[c], *from[c], w);
+      for (int c = 0; c < ElementScalars<G>::count; ++c) add_embedded(*to[c], *from[c], w);
     } else {
       typename G::template Tangent<T> delta;
       for (int c = 0; c < d; ++c) delta(c) = T::variable(0.0, w + c);
       A.g[i] = G::compose(G::template cast<T>(a.g[i]), G::template exp<T>(delta));
     }
   }
-  auto add = [&](const T& f, double scale) {
-    for (int i = 0; i < nx; ++i) {
-      out.gradient(i) += scale * f.g[i];
-      for (int j = i; j < nx; ++j) out.hessian(i, j) += scale * f.H[T::at(i, j)];
-    }
-  };
-  out.gradient.setZero();
-  out.hessian.setZero();
-  add(problem.template lagrangian<T>(A, h), 1.0);
+  // L~ = L_d + Σ λ_c χ_c accumulated in one Hess (contiguous), then unpacked once.
+  T L = problem.template lagrangian<T>(A, h);
   if constexpr (m > 0) {
     const Vec<T, m> chi = problem.template constraints<T>(A, h);
     for (int c = 0; c < m; ++c) {
-      add(chi(c), lam(c));
+      add_scaled(L, lam(c), chi(c));
       out.gradient(nx + c) = chi(c).v;
-      for (int i = 0; i < nx; ++i) out.hessian(i, nx + c) = chi(c).g[i];
+      for (int i = 0; i < nx; ++i) out.hessian(i, nx + c) = out.hessian(nx + c, i) = chi(c).g[i];
     }
+    out.hessian.template bottomRightCorner<m, m>().setZero();
   }
-  out.hessian.template triangularView<Eigen::StrictlyLower>() = out.hessian.transpose();
+  int q = 0;
+  for (int i = 0; i < nx; ++i) {
+    out.gradient(i) = L.g[i];
+    for (int j = i; j < nx; ++j, ++q) out.hessian(i, j) = out.hessian(j, i) = L.H[q];
+  }
 }
 
 // The gradient alone of L~(a) in the window's coordinates, in first-order duals (the λ entries
