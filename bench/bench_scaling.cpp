@@ -7,8 +7,10 @@
 // The beanie at N >= 2 10^4 starts from a coarser grid's solution (the default,
 // ShootingOptions::coarse_start_from); BM_BeanieGalerkin4FromGuess solves it from the guess.
 // Counters: converged, iterations (on the grid itself; coarse_iterations on the coarser ones),
-// unknowns, and the peak resident memory of the process so far (getrusage; a high-water mark,
-// so read it on the largest N of a run).
+// unknowns, the peak resident memory of the process so far (getrusage; a high-water mark, so
+// read it on the largest N of a run), and per solve the minor page faults and the kernel's CPU
+// seconds (all threads): at N = 10⁶ faulting the solve's buffers in again is a third of the time on
+// some hosts, and does not run in parallel (bench/RESULTS.md, "N = 10⁶ on this machine").
 //   ./build/bench/bench_scaling --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
 #include <lpshoot/problems/beanie_bvp.hpp>
 #include <lpshoot/problems/electron_bvp.hpp>
@@ -44,6 +46,20 @@ double peak_rss_mb() {
   return u.ru_maxrss / 1024.0;
 }
 
+rusage usage_now() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u;
+}
+double seconds(const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); }
+
+// Page faults and kernel CPU time per solve between two getrusage samples.
+void report_kernel(benchmark::State& state, const rusage& before, const rusage& after) {
+  const double solves = static_cast<double>(state.iterations());
+  state.counters["faults"] = static_cast<double>(after.ru_minflt - before.ru_minflt) / solves;
+  state.counters["sys_s"] = (seconds(after.ru_stime) - seconds(before.ru_stime)) / solves;
+}
+
 template <class R>
 void report(benchmark::State& state, const R& r) {
   state.counters["converged"] = r.ok() ? 1 : 0;
@@ -58,10 +74,12 @@ void report(benchmark::State& state, const R& r) {
 template <class BVP, class Guess>
 void timed_solves(benchmark::State& state, const BVP& bvp, const Guess& guess, double tolerance, bool from_guess = false) {
   decltype(solve_bvp(bvp, guess)) r;
+  const rusage before = usage_now();
   for (auto _ : state) {
     r = solve_bvp(bvp, guess, options(static_cast<int>(state.range(1)), tolerance, from_guess));
     benchmark::ClobberMemory();
   }
+  report_kernel(state, before, usage_now());
   report(state, r);
 }
 
