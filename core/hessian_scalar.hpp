@@ -245,7 +245,7 @@ void make_variable_in_place(Hess<N>& o, double x, int i) {
   o.g[i] = 1.0;
 }
 
-// e = a, as in add_embedded (e = a + 0 when e is known to be zero: add_embedded alone).
+// e = a, as in add_embedded (when e is already zero, add_embedded alone does it without zeroing e).
 template <int N, int M>
 void embed(Hess<N>& e, const Hess<M>& a, int first) {
   e = Hess<N>();
