@@ -8,6 +8,8 @@
 // band of U to kl + ku, the first kl rows hold that fill.
 #pragma once
 
+#include "huge_pages.hpp"
+
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
@@ -43,8 +45,9 @@ class BandLU {
   // Factors the square A with bandwidths (kl, ku). ok() is false when a pivot is exactly zero
   // (A singular): no solve is then possible.
   BandLU(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& A, int kl, int ku)
-      : n_(static_cast<int>(A.cols())), kl_(kl), ku_(ku), ab_(Eigen::MatrixXd::Zero(2 * kl + ku + 1, A.cols())),
-        pivot_(A.cols()) {
+      : n_(static_cast<int>(A.cols())), kl_(kl), ku_(ku), ab_(2 * kl + ku + 1, A.cols()), pivot_(A.cols()) {
+    advise_huge_pages(ab_.data(), static_cast<std::size_t>(ab_.size()) * sizeof(double));  // before the first touch
+    ab_.setZero();
     for (int c = 0; c < A.outerSize(); ++c)
       for (Eigen::SparseMatrix<double, Eigen::ColMajor, int>::InnerIterator it(A, c); it; ++it)
         at(static_cast<int>(it.row()), c) = it.value();

@@ -19,6 +19,7 @@
 //     (stopped when it crawls, if SolverOptions::stop_when_crawling asks).
 // Exceptions never cross the C frames: they are stored and rethrown after KINSol returns.
 #include "band_lu.hpp"
+#include "huge_pages.hpp"
 #include "nonlinear_solver.hpp"
 
 #include <kinsol/kinsol.h>
@@ -326,6 +327,7 @@ int kinsol_run(KinsolData& data, Eigen::VectorXd& x, const SolverOptions& opt, i
   if (data.band) {
     if (pattern.kl < 0) throw std::invalid_argument("the band linear solver needs the Jacobian's bandwidths");
     k.J = SUNBandMatrix(n, std::min(pattern.ku, n - 1), std::min(pattern.kl, n - 1), k.ctx);
+    if (k.J) advise_huge_pages(SUNBandMatrix_Data(k.J), static_cast<std::size_t>(SUNBandMatrix_LDim(k.J) * SUNBandMatrix_Columns(k.J)) * sizeof(sunrealtype));
     k.LS = k.J ? SUNLinSol_Band(k.u, k.J, k.ctx) : nullptr;
     if (!k.J || !k.LS) throw std::runtime_error("KINSOL: cannot create the band linear solver");
   } else {

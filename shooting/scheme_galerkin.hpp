@@ -6,6 +6,7 @@
 #pragma once
 
 #include "galerkin_boundary.hpp"
+#include "huge_pages.hpp"
 
 #include <Eigen/Core>
 
@@ -63,9 +64,13 @@ struct GalerkinScheme {
   // A run with sensitivities can record a guide for the next run of its segment (GalerkinFlow::run):
   // its memory per step (none without a group, whose steps do not use one).
   static constexpr size_t guide_bytes_per_step = d > 0 ? sizeof(GalerkinStepMemo<Sch>) + sizeof(Interval<Sch, double>) : 0;
+  // A run with sensitivities keeps only its last interval unless it records a guide: shooting
+  // reads its end and sensitivity; the trajectory it returns comes from a run without
+  // (ShootingSystem::runs_at). At N = 10⁶ that is a trajectory's worth of memory (~250 MB for the
+  // electron) not written at every Jacobian.
   static Run run(const Flow& flow, const State& start, int index, int steps, const Eigen::MatrixXd* seed,
                  const Run* guide = nullptr, bool record = false) {
-    return flow.run(start.iv, steps, seed, start.g, index, true, guide, record);
+    return flow.run(start.iv, steps, seed, start.g, index, !seed || record, guide, record);
   }
   static State end_state(const Run& run) { return {run.trajectory.intervals.back(), run.g_last}; }
 
@@ -213,6 +218,7 @@ struct GalerkinScheme {
     size_t total = 1;
     for (const auto& run : runs) total += run.trajectory.intervals.size() - 1;
     tr.intervals.reserve(total);  // one allocation (N up to 1e6: ~100 MB)
+    advise_huge_pages(tr.intervals.data(), total * sizeof(tr.intervals[0]));
     tr.intervals = runs[0].trajectory.intervals;
     for (size_t i = 1; i < runs.size(); ++i) {
       const auto& t = runs[i].trajectory.intervals;

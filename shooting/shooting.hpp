@@ -128,7 +128,7 @@ ShootingResult<X> solve_from_starts(const typename SchemeFor<X>::BVP& bvp,
     out.status = st;
     out.message = std::move(msg);
     out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return out;
+    return std::move(out);  // every call is the function's return: no copy of the trajectory
   };
   ShootingSystem<X> system(bvp, refs, starts, opt.step, opt.threads);
   system.set_on_segment(opt.on_segment);

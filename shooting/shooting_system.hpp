@@ -12,6 +12,7 @@
 #pragma once
 
 #include "band_lu.hpp"
+#include "huge_pages.hpp"
 #include "nonlinear_solver.hpp"
 #include "scheme_galerkin.hpp"
 #include "scheme_nodal.hpp"
@@ -58,6 +59,8 @@ void write_block_columns(SparseJacobian& J, int N, const std::vector<int>& first
   for (int i = 0; i < S; ++i) nnz += (top[i].rows() + bottom[i].rows()) * n;
   J.resize(N, N);  // compressed, no entries
   J.resizeNonZeros(nnz);
+  advise_huge_pages(J.valuePtr(), static_cast<std::size_t>(nnz) * sizeof(double));
+  advise_huge_pages(J.innerIndexPtr(), static_cast<std::size_t>(nnz) * sizeof(int));
   int* outer = J.outerIndexPtr();
   int* inner = J.innerIndexPtr();
   double* value = J.valuePtr();
