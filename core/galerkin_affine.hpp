@@ -52,11 +52,7 @@ StepReport solve_mapped_affine_step(const AffineIntervalGradient<Sch>& gradient,
   const Vec<double, ne> g = gradient.of(z);
   Vec<double, nz> F = flat_right_rows<Sch>(g, h);
   F.template head<nv>() += flat_left_rows<Sch>(carry.interval.gradient, h);
-  if (!all_finite(F.data(), nz)) {
-    rep.status = StepStatus::NonFinite;
-    rep.message = "step n=" + std::to_string(n) + ": the step equations evaluated to a non-finite number";
-    return rep;
-  }
+  if (!all_finite(F.data(), nz)) return non_finite_step(rep, n);
   rep.residual = F.template lpNorm<Eigen::Infinity>();
   const Vec<double, nz> dz = chord.lu.solve(-F);
   apply_galerkin_correction<Sch>(z, dz, h);

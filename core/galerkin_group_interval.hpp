@@ -72,10 +72,7 @@ IntervalDerivatives<Sch> group_interval_derivatives_direct(const typename Sch::M
     out.gradient(ny + c) = C(c).v;
     for (int i = 0; i < ny; ++i) out.hessian(i, ny + c) = out.hessian(ny + c, i) = C(c).g[i];
   }
-  for (int i = 0; i < ny; ++i) {
-    out.gradient(i) = L0.g[i];
-    for (int j = i; j < ny; ++j) out.hessian(i, j) = out.hessian(j, i) = L0.H[T::at(i, j)];
-  }
+  unpack_derivatives(L0, out.gradient, out.hessian);
   return out;
 }
 

@@ -307,13 +307,7 @@ StepReport solve_galerkin_step(const typename Sch::Model& model, double h, const
     fixed = carry && carry->valid ? group_left_rows<Sch>(carry->interval.gradient, h)
                                   : node_residual<Sch, double>(model, &state, nullptr, h);
   }
-  if (!all_finite(fixed.data(), nv)) {
-    StepReport rep;
-    rep.step = n;
-    rep.status = StepStatus::NonFinite;
-    rep.message = "step n=" + std::to_string(n) + ": the step equations evaluated to a non-finite number";
-    return rep;
-  }
+  if (!all_finite(fixed.data(), nv)) return non_finite_step(StepReport(), n);
   return newton_solve<nz>(
       n, opt,
       [&](Vec<double, nz>& F, Eigen::Matrix<double, nz, nz>& J) {

@@ -245,6 +245,17 @@ void make_variable_in_place(Hess<N>& o, double x, int i) {
   o.g[i] = 1.0;
 }
 
+// v's gradient into g(0 .. N-1) and its Hessian, mirrored from the packed upper triangle, into the
+// leading N x N block of H.
+template <int N, class Gradient, class Matrix>
+void unpack_derivatives(const Hess<N>& v, Gradient& g, Matrix& H) {
+  int q = 0;
+  for (int i = 0; i < N; ++i) {
+    g(i) = v.g[i];
+    for (int j = i; j < N; ++j, ++q) H(i, j) = H(j, i) = v.H[q];
+  }
+}
+
 // e = a, as in add_embedded (when e is already zero, add_embedded alone does it without zeroing e).
 template <int N, int M>
 void embed(Hess<N>& e, const Hess<M>& a, int first) {

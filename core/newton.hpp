@@ -41,6 +41,18 @@ struct StepReport {
   std::string message;   // empty when converged
 };
 
+// Why a step failed when its equations evaluated to a non-finite number (an overflow, or a NaN
+// from the model or the state): every step solver reports it in these words.
+inline constexpr char kNonFiniteStep[] = "the step equations evaluated to a non-finite number";
+
+// rep (what the caller filled in) as step n's failure on a non-finite evaluation.
+inline StepReport non_finite_step(StepReport rep, int n) {
+  rep.step = n;
+  rep.status = StepStatus::NonFinite;
+  rep.message = "step n=" + std::to_string(n) + ": " + kNonFiniteStep;
+  return rep;
+}
+
 struct NewtonOptions {
   int max_iterations = 20;
   // Converged when every Newton correction satisfies |dz_i| <= step_tolerance * (1 + |z_i|).
@@ -211,7 +223,7 @@ StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian,
     if (refresh) {
       jacobian(F, J);
       if (!all_finite(F.data(), n) || !all_finite(J.data(), n * n))
-        return fail(StepStatus::NonFinite, "the step equations evaluated to a non-finite number");
+        return fail(StepStatus::NonFinite, kNonFiniteStep);
       lu.compute(J);
       rep.condition = condition_number_1(J, lu);
       factored.condition = rep.condition;
@@ -219,7 +231,7 @@ StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian,
       if (!factored.valid) return fail(StepStatus::Singular, singular_step_reason(rep.condition, opt.max_condition));
     } else {
       residual(F);
-      if (!all_finite(F.data(), n)) return fail(StepStatus::NonFinite, "the step equations evaluated to a non-finite number");
+      if (!all_finite(F.data(), n)) return fail(StepStatus::NonFinite, kNonFiniteStep);
     }
     rep.residual = F.template lpNorm<Eigen::Infinity>();
     const Vn dz = lu.solve(-F);
@@ -247,7 +259,7 @@ StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian,
     };
     const double size = dz.template lpNorm<Eigen::Infinity>();
     if (affine || ((dz.cwiseAbs().array() - opt.step_tolerance * (1.0 + scale.array())) <= 0.0).all()) {
-      if (!polish(size)) return fail(StepStatus::NonFinite, "the step equations evaluated to a non-finite number");
+      if (!polish(size)) return fail(StepStatus::NonFinite, kNonFiniteStep);
       rep.status = StepStatus::Converged;
       return rep;
     }
@@ -297,7 +309,7 @@ StepReport newton_solve(int step, const NewtonOptions& opt, Jacobian&& jacobian,
     if (stalled) {
       if (within_noise(dz, scale)) {
         rep.noise_sample = (dz.cwiseAbs().array() / (1.0 + scale.array())).maxCoeff();
-        if (!refresh && !polish(size)) return fail(StepStatus::NonFinite, "the step equations evaluated to a non-finite number");
+        if (!refresh && !polish(size)) return fail(StepStatus::NonFinite, kNonFiniteStep);
         rep.status = StepStatus::Converged;
         return rep;
       }

@@ -95,11 +95,7 @@ StepReport solve_mapped_affine_paper_step(const AffineWindowGradient<P>& gradien
   F.template head<r>() = g.template head<r>();
   for (int j = 0; j < k; ++j) F.template head<r>() += carry.of(n - k + j).gradient.template segment<r>((k - j) * r);
   if constexpr (m > 0) F.template tail<m>() = g.template tail<m>();
-  if (!all_finite(F.data(), nz)) {
-    rep.status = StepStatus::NonFinite;
-    rep.message = "step n=" + std::to_string(n) + ": the step equations evaluated to a non-finite number";
-    return rep;
-  }
+  if (!all_finite(F.data(), nz)) return non_finite_step(rep, static_cast<int>(n));
   rep.residual = F.template lpNorm<Eigen::Infinity>();
   const Vec<double, nz> dz = chord.lu.solve(-F);
   apply_correction(z, dz);

@@ -98,13 +98,7 @@ StepReport solve_step(const P& problem, double h, const FlowState<P>& s, int n, 
   } else {
     fixed = step_fixed_part(problem, h, s, z);
   }
-  if (!all_finite(fixed.data(), D::node)) {
-    StepReport rep;
-    rep.step = n;
-    rep.status = StepStatus::NonFinite;
-    rep.message = "step n=" + std::to_string(n) + ": the step equations evaluated to a non-finite number";
-    return rep;
-  }
+  if (!all_finite(fixed.data(), D::node)) return non_finite_step(StepReport(), n);
   // In a flow with sensitivities (a carry) with a group (k >= 2), F from window a_n's gradient and
   // increment n's perturbation, which depends on the state alone (step_residual_from_window):
   // beanie control, ~half a residual; such a flow's steps end on confirmations from the windows'

@@ -88,11 +88,7 @@ void window_hessian(const P& problem, const Window<P, double>& a, const Vec<doub
     }
     out.hessian.template bottomRightCorner<m, m>().setZero();
   }
-  int q = 0;
-  for (int i = 0; i < nx; ++i) {
-    out.gradient(i) = L.g[i];
-    for (int j = i; j < nx; ++j, ++q) out.hessian(i, j) = out.hessian(j, i) = L.H[q];
-  }
+  unpack_derivatives(L, out.gradient, out.hessian);
 }
 
 // The gradient alone of L~(a) in the window's coordinates, in first-order duals (the λ entries
