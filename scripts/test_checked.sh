@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # The checked build: Debug (Eigen's assertions on) with AddressSanitizer and
 # UndefinedBehaviorSanitizer, in ./build-checked; runs the core and shooting tests of label
-# "checked" (what CI runs: all of label "core" but its five largest instances, tests/CMakeLists.txt),
-# with --core all the core and shooting tests, with --all every test (the application's and the
-# fuzz test included).
+# "core_checked" (what CI runs: all the core tests but the five largest instances,
+# tests/CMakeLists.txt), with --core all the core and shooting tests (labels core and
+# core_checked), with --all every test (the application's and the fuzz test included).
 #   bash scripts/test_checked.sh [--core | --all]
 set -euo pipefail
 cd "$(dirname "$0")/.."
