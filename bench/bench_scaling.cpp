@@ -9,8 +9,9 @@
 // Counters: converged, iterations (on the grid itself; coarse_iterations on the coarser ones),
 // unknowns, the peak resident memory of the process so far (getrusage; a high-water mark, so
 // read it on the largest N of a run), and per solve the minor page faults and the kernel's CPU
-// seconds (all threads): at N = 10⁶ faulting the solve's buffers in again is a third of the time on
-// some hosts, and does not run in parallel (bench/RESULTS.md, "N = 10⁶ on this machine").
+// seconds (all threads): at N = 10⁶ faulting the solve's buffers in was a third of the time on some
+// hosts, and does not run in parallel (bench/RESULTS.md, "N = 10⁶ on this machine"; since 2836cca
+// runs with sensitivities keep no trajectory and large buffers are advised to huge pages).
 //   ./build/bench/bench_scaling --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
 #include <lpshoot/problems/beanie_bvp.hpp>
 #include <lpshoot/problems/electron_bvp.hpp>
