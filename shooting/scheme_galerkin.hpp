@@ -66,7 +66,7 @@ struct GalerkinScheme {
   static constexpr size_t guide_bytes_per_step = d > 0 ? sizeof(GalerkinStepMemo<Sch>) + sizeof(Interval<Sch, double>) : 0;
   // A run with sensitivities keeps only its last interval unless it records a guide: shooting
   // reads its end and sensitivity; the trajectory it returns comes from a run without
-  // (ShootingSystem::runs_at). At N = 10⁶ that is a trajectory's worth of memory (~250 MB for the
+  // (ShootingSystem::runs_at). At N = 10⁶ that is a trajectory's worth of memory (~100 MB for the
   // electron) not written at every Jacobian.
   static Run run(const Flow& flow, const State& start, int index, int steps, const Eigen::MatrixXd* seed,
                  const Run* guide = nullptr, bool record = false) {
