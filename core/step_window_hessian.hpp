@@ -18,6 +18,7 @@
 #include "group_element_scalars.hpp"
 #include "hessian_scalar.hpp"
 #include "local_action.hpp"
+#include "taped_hessian.hpp"
 
 #include <array>
 
@@ -45,10 +46,23 @@ struct WindowHessian {
   long index = -1;
 };
 
+// exp(δ) at δ = 0 with δ's d coordinates seeded in TD (Dual<double, d> or Hess<d>): constants
+// of the group, computed once (its series in TD cost ~10% of a beanie step when taken per window).
+template <class G, class TD>
+const typename G::template Element<TD>& exp_of_seeded_zero() {
+  static const typename G::template Element<TD> e = [] {
+    typename G::template Tangent<TD> delta;
+    for (int c = 0; c < G::dim; ++c) delta(c) = TD::variable(0.0, c);
+    return G::template exp<TD>(delta);
+  }();
+  return e;
+}
+
 // L_d and χ_d in Hess<nw - m> arithmetic (the window's nodes and increments); L~ = L_d + λ·χ_d is
-// linear in λ, so its λ rows are χ_d's gradient and its λλ block is zero.
+// linear in λ, so its λ rows are χ_d's gradient and its λλ block is zero. The reference for
+// window_hessian_taped, and the route for groups without element scalars.
 template <class P>
-void window_hessian(const P& problem, const Window<P, double>& a, const Vec<double, P::num_constraints>& lam, double h,
+void window_hessian_forward(const P& problem, const Window<P, double>& a, const Vec<double, P::num_constraints>& lam, double h,
                     WindowHessian<P>& out) {
   using G = typename P::Group;
   constexpr int k = P::order, r = P::shape_dim, d = G::dim, m = P::num_constraints, nw = window_coordinates<P>();
@@ -65,9 +79,7 @@ void window_hessian(const P& problem, const Window<P, double>& a, const Vec<doub
     if constexpr (has_element_scalars<G>()) {
       // g~ exp(δ) depends on δ alone: computed in Hess<d>, placed in its d directions.
       using TD = Hess<d>;
-      typename G::template Tangent<TD> delta;
-      for (int c = 0; c < d; ++c) delta(c) = TD::variable(0.0, c);
-      auto moved = G::compose(G::template cast<TD>(a.g[i]), G::template exp<TD>(delta));
+      auto moved = G::compose(G::template cast<TD>(a.g[i]), exp_of_seeded_zero<G, TD>());
       const auto from = ElementScalars<G>::of(moved);
       const auto to = ElementScalars<G>::of(A.g[i]);
       for (int c = 0; c < ElementScalars<G>::count; ++c) add_embedded(*to[c], *from[c], w);
@@ -91,6 +103,79 @@ void window_hessian(const P& problem, const Window<P, double>& a, const Vec<doub
   unpack_derivatives(L, out.gradient, out.hessian);
 }
 
+// The same derivatives by reverse over forward (taped_hessian.hpp): L_d and χ_d run once in
+// first-order arithmetic on a tape, and one reverse sweep with the weights (1, λ) gives ∇²L~ in the
+// nodes and increments. The increments' scalars u = g~ exp(δ) are computed in Hess<d> (they
+// depend on δ alone) and enter the tape as sources with their gradients; their own curvature
+// adds ū ∇²u, ū their adjoints. Equal to window_hessian_forward to rounding (tests).
+template <class P>
+void window_hessian_taped(const P& problem, const Window<P, double>& a, const Vec<double, P::num_constraints>& lam,
+                          double h, WindowHessian<P>& out) {
+  using G = typename P::Group;
+  constexpr int k = P::order, r = P::shape_dim, d = G::dim, m = P::num_constraints, nw = window_coordinates<P>();
+  constexpr int nx = nw - m, s = ElementScalars<G>::count;
+  using T = Taped<nx>;
+  using TD = Hess<d>;
+  thread_local Tape<nx> tape;  // reused: its buffers grow once per thread
+  tape.clear();
+  Window<P, T> A;
+  int w = 0;
+  for (int i = 0; i <= k; ++i)
+    for (int c = 0; c < r; ++c, ++w) A.p[i](c) = tape.variable(a.p[i](c), w);
+  A.p_low = a.p_low;
+  std::array<std::array<TD, s>, k> increment_scalars;
+  for (int i = 0; i < k; ++i, w += d) {
+    auto moved = G::compose(G::template cast<TD>(a.g[i]), exp_of_seeded_zero<G, TD>());
+    const auto from = ElementScalars<G>::of(moved);
+    const auto to = ElementScalars<G>::of(A.g[i]);
+    for (int c = 0; c < s; ++c) {
+      Eigen::Matrix<double, nx, 1> g = Eigen::Matrix<double, nx, 1>::Zero();
+      for (int b = 0; b < d; ++b) g(w + b) = from[c]->g[b];
+      *to[c] = tape.source(from[c]->v, g);
+      increment_scalars[i][c] = *from[c];
+    }
+  }
+  const T L = problem.template lagrangian<T>(A, h);
+  Eigen::Matrix<double, nx, 1> gradient = tape.gradient(L);
+  tape.seed(L, 1.0);
+  if constexpr (m > 0) {
+    const Vec<T, m> chi = problem.template constraints<T>(A, h);
+    for (int c = 0; c < m; ++c) {
+      const Eigen::Matrix<double, nx, 1> gc = tape.gradient(chi(c));
+      gradient += lam(c) * gc;
+      tape.seed(chi(c), lam(c));
+      out.gradient(nx + c) = chi(c).v;
+      for (int i = 0; i < nx; ++i) out.hessian(i, nx + c) = out.hessian(nx + c, i) = gc(i);
+    }
+    out.hessian.template bottomRightCorner<m, m>().setZero();
+  }
+  Eigen::Matrix<double, nx, nx> H = Eigen::Matrix<double, nx, nx>::Zero();
+  tape.sweep(H);
+  w = (k + 1) * r;
+  for (int i = 0; i < k; ++i, w += d) {
+    const auto to = ElementScalars<G>::of(A.g[i]);
+    for (int c = 0; c < s; ++c) {
+      const double u = tape.adjoint(*to[c]);
+      if (u == 0.0) continue;
+      for (int p = 0; p < d; ++p)
+        for (int q = 0; q < d; ++q) H(w + p, w + q) += u * increment_scalars[i][c].hessian(p, q);
+    }
+  }
+  out.gradient.template head<nx>() = gradient;
+  out.hessian.template topLeftCorner<nx, nx>() = H;
+}
+
+// L~(a)'s gradient and Hessian (WindowHessian): by the tape where the group's elements are
+// stored as scalars, otherwise in Hess arithmetic.
+template <class P>
+void window_hessian(const P& problem, const Window<P, double>& a, const Vec<double, P::num_constraints>& lam, double h,
+                    WindowHessian<P>& out) {
+  if constexpr (has_element_scalars<typename P::Group>())
+    window_hessian_taped(problem, a, lam, h, out);
+  else
+    window_hessian_forward(problem, a, lam, h, out);
+}
+
 // The gradient alone of L~(a) in the window's coordinates, in first-order duals (the λ entries
 // are χ_d). With the increments' perturbations B, a step's residual is Σ Bᵀ g over its windows
 // (the file comment); for window a_n this costs one pass in Dual<nw - m> over the user's L_d
@@ -112,9 +197,7 @@ Vec<double, window_coordinates<P>()> window_gradient(const P& problem, const Win
     if constexpr (has_element_scalars<G>()) {
       // g~ exp(δ) depends on δ alone: computed in Dual<d>, placed in its d directions.
       using TD = Dual<double, d>;
-      typename G::template Tangent<TD> delta;
-      for (int c = 0; c < d; ++c) delta(c) = TD::variable(0.0, c);
-      auto moved = G::compose(G::template cast<TD>(a.g[i]), G::template exp<TD>(delta));
+      auto moved = G::compose(G::template cast<TD>(a.g[i]), exp_of_seeded_zero<G, TD>());
       const auto from = ElementScalars<G>::of(moved);
       const auto to = ElementScalars<G>::of(A.g[i]);
       for (int c = 0; c < ElementScalars<G>::count; ++c) {
