@@ -3,14 +3,17 @@
 // condition estimate). Eigen's PartialPivLU sends fixed sizes through its blocked kernels for
 // dynamic matrices (gebp, trsm, packing): at the Galerkin 6 beanie step (n = 21, 26 right-hand
 // sides) its factorization and many-column solve took 2.0 and 3.3 µs, these loops 1.5 and 1.7 µs
-// (bench/RESULTS.md, "Small step matrices"). Same pivots, results equal to rounding.
+// (bench/RESULTS.md, "Small step matrices"). Same pivots.
 // The one-vector solves work on a local array with fully unrolled loops: written through the
 // result (or with Eigen's run-time-sized segments) every update went through memory, in a
 // serial chain of store-to-load forwarding (7 × 7: 102 against 33 ns; bench/RESULTS.md, "The
-// small solves in registers"). solve() keeps the order of operations, so its results are the
-// same to the bit.
-// A zero pivot is kept (no division): solves then return inf or NaN, which the condition
-// estimate reports as a singular matrix (newton.hpp), as with Eigen's.
+// small solves in registers"). The solves multiply by U's diagonal's reciprocals, kept from the
+// factorization (a back substitution divided in a serial chain of ~13-cycle latencies; with the
+// many-column solve's, ~7% of a beanie paper step with its sensitivity: bench/RESULTS.md, "Window
+// Hessians on a tape"): their results differ from Eigen's by rounding, one more per division.
+// The factors are Eigen's to rounding (the elimination divides, as Eigen does).
+// A zero pivot is kept: its reciprocal is inf, and solves then return inf or NaN, which the
+// condition estimate reports as a singular matrix (newton.hpp), as with Eigen's.
 #pragma once
 
 #include <Eigen/Core>
@@ -54,6 +57,7 @@ class SmallLU {
       }
     }
     for (int i = 0; i < n * n; ++i) lu_.data()[i] = t[i];
+    for (int i = 0; i < n; ++i) inverse_diagonal_[i] = 1.0 / t[i * n + i];
     for (int i = 0; i < n; ++i) row_[i] = i;
     for (int k = 0; k < n; ++k) std::swap(row_[k], row_[pivot_[k]]);
   }
@@ -69,7 +73,7 @@ class SmallLU {
       for (int i = k + 1; i < n; ++i) t[i] -= t[k] * lu_(i, k);
 #pragma GCC unroll 32
     for (int k = n - 1; k >= 0; --k) {
-      t[k] /= lu_(k, k);
+      t[k] *= inverse_diagonal_[k];
 #pragma GCC unroll 32
       for (int i = 0; i < k; ++i) t[i] -= t[k] * lu_(i, k);
     }
@@ -93,7 +97,7 @@ class SmallLU {
     for (int i = n - 1; i >= 0; --i) {
       Eigen::Matrix<double, m, 1> row = xt.col(i);
       for (int k = i + 1; k < n; ++k) row -= lu_(i, k) * xt.col(k);
-      xt.col(i) = row / lu_(i, i);
+      xt.col(i) = row * inverse_diagonal_[i];
     }
     return xt.transpose();
   }
@@ -106,7 +110,7 @@ class SmallLU {
     for (int i = 0; i < n; ++i) t[i] = b(i);
 #pragma GCC unroll 32
     for (int k = 0; k < n; ++k) {
-      t[k] /= lu_(k, k);
+      t[k] *= inverse_diagonal_[k];
 #pragma GCC unroll 32
       for (int i = k + 1; i < n; ++i) t[i] -= t[k] * lu_(k, i);
     }
@@ -134,6 +138,7 @@ class SmallLU {
   Matrix lu_ = Matrix::Zero();
   std::array<int, n> pivot_{};  // row k was interchanged with row pivot_[k] >= k
   std::array<int, n> row_{};    // row i of PA is row row_[i] of A
+  std::array<double, n> inverse_diagonal_{};  // 1 / U(i, i)
 };
 
 }  // namespace lpshoot
