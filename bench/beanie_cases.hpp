@@ -1,8 +1,8 @@
-// The beanie control's paper-scheme state at step 2, shared by the step benchmarks (bench_step,
-// bench_ratios).
+// The beanie control's paper-scheme state at step 2 and its Galerkin scheme's first interval,
+// shared by the step benchmarks (bench_step, bench_galerkin_step, bench_ratios).
 #pragma once
 
-#include <lpshoot/problems/beanie.hpp>
+#include "beanie_galerkin_start.hpp"  // tests/
 
 namespace lpshoot::bench {
 
@@ -20,6 +20,18 @@ inline FlowState<problems::BeanieControl> beanie_state(const problems::BeanieCon
   for (int i = 1; i < 3; ++i) s.g[i] = b.next_increment(s.g[i - 1], s.p[i](0) - s.p[i - 1](0));
   s.lam = {Eigen::Vector3d(0.3, -0.2, 0.1), Eigen::Vector3d(0.302, -0.199, 0.101)};
   return s;
+}
+
+inline problems::BeanieModel beanie_model() {
+  problems::BeanieModel b;
+  b.par = {1.0, 1.0, 0.5, 1.0};
+  return b;
+}
+
+// The first interval of the Galerkin guess of bench_galerkin_step and bench_ratios (N = 200).
+template <int S>
+Interval<problems::BeanieGalerkin<S>, double> beanie_galerkin_start(const problems::BeanieModel& model) {
+  return test_support::beanie_interval_with_multipliers<S>(model, 2.0, 200);
 }
 
 }  // namespace lpshoot::bench

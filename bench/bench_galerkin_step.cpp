@@ -6,6 +6,7 @@
 #include <lpshoot/problems/beanie_bvp.hpp>
 #include <lpshoot/problems/electron_bvp.hpp>
 
+#include "beanie_cases.hpp"
 #include "electron_cases.hpp"
 #include "oracles/galerkin_electron.hpp"
 
@@ -13,24 +14,12 @@
 
 using namespace lpshoot;
 using namespace lpshoot::problems;
+using lpshoot::bench::beanie_galerkin_start;
 using lpshoot::bench::electron_start;
 
 namespace {
 
 constexpr double kH = 0.01;
-
-// The first interval of each example's guess, with non-zero bubbles and multipliers.
-template <int S>
-Interval<BeanieGalerkin<S>, double> beanie_start(const BeanieModel& model) {
-  BeanieBoundary s, e;
-  s.psi = 0.2, s.psi_dot = 0.4, s.theta = 0.1, s.x = 0, s.y = 0, s.Omega1 = 0.5, s.Omega2 = 0.2;
-  e.psi = 1, e.psi_dot = 0, e.theta = 1;
-  const auto bvp = beanie_galerkin_bvp<S>(model, 2.0, 200, s, e);
-  auto iv = beanie_galerkin_guess<S>(bvp, s, e).trajectory.intervals[0];
-  for (int i = 0; i < BeanieGalerkin<S>::aux; ++i) iv.w(i) = 0.01 * std::sin(1.0 + i);
-  return iv;
-}
-
 
 template <class Sch>
 void step(benchmark::State& st, const typename Sch::Model& model, const Interval<Sch, double>& start, bool sensitivity) {
@@ -66,17 +55,13 @@ void flow(benchmark::State& st, const typename Sch::Model& model, const Interval
   st.counters["newton_per_step"] = static_cast<double>(iterations) / steps;  // the step solves' iterations
 }
 
-BeanieModel beanie() {
-  BeanieModel b;
-  b.par = {1.0, 1.0, 0.5, 1.0};
-  return b;
-}
+BeanieModel beanie() { return bench::beanie_model(); }
 
 }  // namespace
 
 template <int S>
 static void BM_BeanieGalerkinStep(benchmark::State& st) {
-  step<BeanieGalerkin<S>>(st, beanie(), beanie_start<S>(beanie()), st.range(0) != 0);
+  step<BeanieGalerkin<S>>(st, beanie(), beanie_galerkin_start<S>(beanie()), st.range(0) != 0);
 }
 BENCHMARK_TEMPLATE(BM_BeanieGalerkinStep, 3)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 BENCHMARK_TEMPLATE(BM_BeanieGalerkinStep, 4)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
@@ -167,7 +152,7 @@ BENCHMARK_TEMPLATE(BM_ElectronStepDerivatives, 4)->Arg(0)->Arg(1)->Unit(benchmar
 // to their rounding (~5e-12 relative to the unknowns) and each step's Newton ends at that noise.
 template <int S>
 static void BM_BeanieGalerkinFlow(benchmark::State& st) {
-  flow<BeanieGalerkin<S>>(st, beanie(), beanie_start<S>(beanie()), st.range(0) != 0, st.range(1) ? 2e-5 : kH);
+  flow<BeanieGalerkin<S>>(st, beanie(), beanie_galerkin_start<S>(beanie()), st.range(0) != 0, st.range(1) ? 2e-5 : kH);
 }
 BENCHMARK_TEMPLATE(BM_BeanieGalerkinFlow, 3)->ArgsProduct({{0, 1}, {0, 1}})->Unit(benchmark::kMillisecond);
 BENCHMARK_TEMPLATE(BM_BeanieGalerkinFlow, 4)->ArgsProduct({{0, 1}, {0, 1}})->Unit(benchmark::kMillisecond);

@@ -8,6 +8,10 @@
 //   - the electron flow of the paper scheme, 200 steps, 12 state directions seeded, per step,
 //     against the hand-written flow (its closed-form step map formed once per flow,
 //     tests/oracles/analytic_steps.cpp), which is also its sensitivity;
+//   - the beanie Galerkin 4 flow, 200 steps, 19 state directions seeded, per step, against the
+//     hand-written flow (tests/oracles/galerkin_beanie.cpp: the engine flow's way of taking the
+//     steps, extrapolated predictors, chord iterations on the previous step's matrix, carried
+//     interval derivatives, predicted ends confirmed at the sensitivity, implicit sensitivity);
 //   - the beanie control step of the paper scheme as a flow takes it (bench_step's "as in a
 //     flow" loop: carried window Hessians, the chord matrix), against the hand-written step
 //     with its tangent-linear sensitivity (tests/oracles/analytic_steps.cpp).
@@ -16,6 +20,7 @@
 #include "electron_cases.hpp"
 #include "step_as_in_a_flow.hpp"
 #include "oracles/analytic_steps.hpp"
+#include "oracles/galerkin_beanie.hpp"
 #include "oracles/galerkin_electron.hpp"
 
 #include <algorithm>
@@ -119,6 +124,37 @@ void electron_paper_flow() {
               te / steps, th / steps, te / th);
 }
 
+void beanie_galerkin_flow() {
+  using Sch = BeanieGalerkin<3>;
+  constexpr double h = 0.01;
+  constexpr int steps = 200;
+  const BeanieModel model = bench::beanie_model();
+  const auto start = bench::beanie_galerkin_start<3>(model);
+  const GalerkinFlow<Sch> flow(model, h);
+  const Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(Sch::state, Sch::state);
+  int engine_iterations = 0, hand_iterations = 0;
+  auto engine = [&] {
+    const auto r = flow.run(start, steps, &seed, Sch::Group::template identity<double>(), 0, false);
+    if (!r.report.ok()) std::printf("beanie Galerkin flow failed: %s\n", r.report.message.c_str());
+    engine_iterations = r.report.total_iterations;
+    asm volatile("" : : "r"(r.sensitivity.data()) : "memory");
+  };
+  oracles::GalerkinBeanieInterval s0;
+  s0.y << start.x, start.v, start.Om, start.X2, start.V1, start.O1;
+  s0.W_angle = start.W.angle, s0.W_t = start.W.t;
+  s0.lambda = start.w;
+  auto hand = [&] {
+    const auto r = oracles::galerkin4_beanie_flow(model.par, h, s0, steps);
+    if (!r.converged) std::printf("hand beanie Galerkin flow stopped at step %d\n", r.steps + 1);
+    hand_iterations = r.iterations;
+    asm volatile("" : : "r"(r.sensitivity.data()) : "memory");
+  };
+  const auto [te, th] = alternated_minima(engine, hand, 50);
+  std::printf("beanie Galerkin 4 flow with sensitivities, per step: engine %.0f ns, hand-written %.0f ns, ratio %.2f "
+              "(Newton iterations per step: engine %.2f, hand %.2f)\n",
+              te / steps, th / steps, te / th, double(engine_iterations) / steps, double(hand_iterations) / steps);
+}
+
 void beanie_paper_step() {
   using P = BeanieControl;
   const BeanieControl b = bench::beanie_control();
@@ -144,6 +180,7 @@ void beanie_paper_step() {
 int main() {
   electron_galerkin_flow();
   electron_paper_flow();
+  beanie_galerkin_flow();
   beanie_paper_step();
   return 0;
 }
