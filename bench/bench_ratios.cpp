@@ -8,8 +8,8 @@
 //   - the electron flow of the paper scheme, 200 steps, 12 state directions seeded, per step,
 //     against the hand-written flow (its closed-form step map formed once per flow,
 //     tests/oracles/analytic_steps.cpp), which is also its sensitivity;
-//   - the beanie Galerkin 4 flow, 200 steps, 19 state directions seeded, per step, against the
-//     hand-written flow (tests/oracles/galerkin_beanie.cpp: the engine flow's way of taking the
+//   - the beanie Galerkin 4 and 6 flows, 200 steps, the state's 19 or 26 directions seeded, per
+//     step, against the hand-written flow (tests/oracles/galerkin_beanie.cpp: the engine flow's way of taking the
 //     steps, extrapolated predictors, chord iterations on the previous step's matrix, carried
 //     interval derivatives, predicted ends confirmed at the sensitivity, implicit sensitivity);
 //   - the beanie control step of the paper scheme as a flow takes it (bench_step's "as in a
@@ -124,12 +124,13 @@ void electron_paper_flow() {
               te / steps, th / steps, te / th);
 }
 
+template <int S>
 void beanie_galerkin_flow() {
-  using Sch = BeanieGalerkin<3>;
+  using Sch = BeanieGalerkin<S>;
   constexpr double h = 0.01;
   constexpr int steps = 200;
   const BeanieModel model = bench::beanie_model();
-  const auto start = bench::beanie_galerkin_start<3>(model);
+  const auto start = bench::beanie_galerkin_start<S>(model);
   const GalerkinFlow<Sch> flow(model, h);
   const Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(Sch::state, Sch::state);
   int engine_iterations = 0, hand_iterations = 0;
@@ -139,20 +140,20 @@ void beanie_galerkin_flow() {
     engine_iterations = r.report.total_iterations;
     asm volatile("" : : "r"(r.sensitivity.data()) : "memory");
   };
-  oracles::GalerkinBeanieInterval s0;
+  oracles::GalerkinBeanieInterval<S> s0;
   s0.y << start.x, start.v, start.Om, start.X2, start.V1, start.O1;
   s0.W_angle = start.W.angle, s0.W_t = start.W.t;
-  s0.lambda = start.w;
+  s0.aux = start.w;
   auto hand = [&] {
-    const auto r = oracles::galerkin4_beanie_flow(model.par, h, s0, steps);
+    const auto r = oracles::galerkin_beanie_flow<S>(model.par, h, s0, steps);
     if (!r.converged) std::printf("hand beanie Galerkin flow stopped at step %d\n", r.steps + 1);
     hand_iterations = r.iterations;
     asm volatile("" : : "r"(r.sensitivity.data()) : "memory");
   };
   const auto [te, th] = alternated_minima(engine, hand, 50);
-  std::printf("beanie Galerkin 4 flow with sensitivities, per step: engine %.0f ns, hand-written %.0f ns, ratio %.2f "
+  std::printf("beanie Galerkin %d flow with sensitivities, per step: engine %.0f ns, hand-written %.0f ns, ratio %.2f "
               "(Newton iterations per step: engine %.2f, hand %.2f)\n",
-              te / steps, th / steps, te / th, double(engine_iterations) / steps, double(hand_iterations) / steps);
+              Sch::order, te / steps, th / steps, te / th, double(engine_iterations) / steps, double(hand_iterations) / steps);
 }
 
 void beanie_paper_step() {
@@ -180,7 +181,8 @@ void beanie_paper_step() {
 int main() {
   electron_galerkin_flow();
   electron_paper_flow();
-  beanie_galerkin_flow();
+  beanie_galerkin_flow<3>();
+  beanie_galerkin_flow<4>();
   beanie_paper_step();
   return 0;
 }
