@@ -8,6 +8,7 @@
 
 #include "beanie_cases.hpp"
 #include "electron_cases.hpp"
+#include "oracles/galerkin_beanie.hpp"
 #include "oracles/galerkin_electron.hpp"
 
 #include <benchmark/benchmark.h>
@@ -147,6 +148,30 @@ static void BM_ElectronStepDerivatives(benchmark::State& st) {
 }
 BENCHMARK_TEMPLATE(BM_ElectronStepDerivatives, 3)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 BENCHMARK_TEMPLATE(BM_ElectronStepDerivatives, 4)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+// One beanie interval's L~ gradient and Hessian in its coordinates (what a step with its
+// sensitivity evaluates once, galerkin_group_interval.hpp): /0 the engine's, derived from
+// BeanieModel's ℓ and χ, /1 written by hand (tests/oracles/galerkin_beanie.cpp).
+template <int S>
+static void BM_BeanieIntervalDerivatives(benchmark::State& st) {
+  const BeanieModel m = beanie();
+  const auto iv = beanie_galerkin_start<S>(m);
+  oracles::GalerkinBeanieInterval<S> o;
+  o.y << iv.x, iv.v, iv.Om, iv.X2, iv.V1, iv.O1;
+  o.W_angle = iv.W.angle, o.W_t = iv.W.t;
+  o.aux = iv.w;
+  for (auto _ : st) {
+    if (st.range(0) == 0) {
+      auto d = group_interval_derivatives<BeanieGalerkin<S>>(m, iv, kH);
+      benchmark::DoNotOptimize(d.hessian.data());
+    } else {
+      auto d = oracles::galerkin_beanie_derivatives<S>(m.par, kH, o);
+      benchmark::DoNotOptimize(d.hessian.data());
+    }
+  }
+}
+BENCHMARK_TEMPLATE(BM_BeanieIntervalDerivatives, 3)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK_TEMPLATE(BM_BeanieIntervalDerivatives, 4)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 // Second argument 1: h = 2e-5 (the beanie at N = 10^5), where the step equations are known only
 // to their rounding (~5e-12 relative to the unknowns) and each step's Newton ends at that noise.

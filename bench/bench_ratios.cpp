@@ -3,8 +3,9 @@
 // the minimum of each side is kept, so a slow spell of a shared machine (they last seconds to
 // minutes here, and moved bench_step's separate medians by up to 1.5x) hits both sides or
 // neither. Pairs:
-//   - the electron Galerkin 4 flow, 200 steps, 12 state directions seeded, per step, against
-//     the hand-written flow of bench_galerkin_step (the step map formed once per flow);
+//   - the electron Galerkin 4 and 6 flows, 200 steps, the state's 12 or 15 directions seeded, per
+//     step, against the hand-written flows (the step map formed once per flow: Galerkin 4 as in
+//     bench_galerkin_step);
 //   - the electron flow of the paper scheme, 200 steps, 12 state directions seeded, per step,
 //     against the hand-written flow (its closed-form step map formed once per flow,
 //     tests/oracles/analytic_steps.cpp), which is also its sensitivity;
@@ -50,40 +51,48 @@ std::pair<double, double> alternated_minima(A&& a, B&& b, int calls, int rounds 
   return {ta, tb};
 }
 
+// The electron's hand step maps, Galerkin 4 and 6 (tests/oracles/galerkin_electron.cpp).
+Eigen::MatrixXd electron_hand_map(int S, const ElectronModel& m, double h) {
+  if (S == 3) return oracles::electron_galerkin4_step_map(m, h);
+  return oracles::electron_galerkin6_step_map(m, h);
+}
+
+template <int S>
 void electron_galerkin_flow() {
-  using Sch = ElectronGalerkin<3>;
+  using Sch = ElectronGalerkin<S>;
+  constexpr int ns = Sch::state, nz = Sch::unknowns;
   constexpr double h = 0.01;
   constexpr int steps = 200;
   const ElectronModel m = model_of(Electron{});
-  const auto start = bench::electron_start<3>(m);
+  const auto start = bench::electron_start<S>(m);
   const GalerkinFlow<Sch> flow(m, h);
-  const Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(Sch::state, Sch::state);
+  const Eigen::MatrixXd seed = Eigen::MatrixXd::Identity(ns, ns);
   auto engine = [&] {
     const auto r = flow.run(start, steps, &seed, Sch::Group::template identity<double>(), 0, false);
     if (!r.report.ok()) std::printf("electron flow failed: %s\n", r.report.message.c_str());
     asm volatile("" : : "r"(r.sensitivity.data()) : "memory");
   };
-  oracles::GalerkinElectronState c0;
-  c0 << start.x, start.v, start.X2, start.V1;
-  auto hand = [&] {  // as BM_ElectronHandGalerkinFlow/1
-    const oracles::GalerkinElectronMap Phi = oracles::electron_galerkin4_step_map(m, h);
-    oracles::GalerkinElectronState c = c0, cn;
-    Eigen::Matrix<double, 12, 12> S = Eigen::Matrix<double, 12, 12>::Identity(), next;
+  Eigen::Matrix<double, ns, 1> c0;
+  c0 << start.x, start.v, start.X2, start.V1, start.w;
+  auto hand = [&] {  // as BM_ElectronHandGalerkinFlow/1: the step map formed once per flow
+    const Eigen::Matrix<double, nz, ns> Phi = electron_hand_map(S, m, h);
+    Eigen::Matrix<double, ns, 1> c = c0, cn;
+    Eigen::Matrix<double, ns, ns> S_ = Eigen::Matrix<double, ns, ns>::Identity(), next;
     for (int k = 0; k < steps; ++k) {
-      cn.head<3>() = c.head<3>() + h * c.segment<3>(3) + (h * h) * c.segment<3>(6);
-      cn.segment<3>(3) = c.segment<3>(3) + h * c.tail<3>();
-      cn.tail<6>().noalias() = Phi * c;
+      cn.template head<3>() = c.template head<3>() + h * c.template segment<3>(3) + (h * h) * c.template segment<3>(6);
+      cn.template segment<3>(3) = c.template segment<3>(3) + h * c.template segment<3>(9);
+      cn.template tail<nz>().noalias() = Phi * c;
       c.swap(cn);
-      next.topRows<3>() = S.topRows<3>() + h * S.middleRows<3>(3) + (h * h) * S.middleRows<3>(6);
-      next.middleRows<3>(3) = S.middleRows<3>(3) + h * S.bottomRows<3>();
-      next.bottomRows<6>().noalias() = Phi.lazyProduct(S);
-      S.swap(next);
+      next.template topRows<3>() = S_.template topRows<3>() + h * S_.template middleRows<3>(3) + (h * h) * S_.template middleRows<3>(6);
+      next.template middleRows<3>(3) = S_.template middleRows<3>(3) + h * S_.template middleRows<3>(9);
+      next.template bottomRows<nz>().noalias() = Phi.lazyProduct(S_);
+      S_.swap(next);
     }
-    asm volatile("" : : "r"(c.data()), "r"(S.data()) : "memory");
+    asm volatile("" : : "r"(c.data()), "r"(S_.data()) : "memory");
   };
   const auto [te, th] = alternated_minima(engine, hand, 500);
-  std::printf("electron Galerkin 4 flow with sensitivities, per step: engine %.0f ns, hand-written %.0f ns, ratio %.2f\n",
-              te / steps, th / steps, te / th);
+  std::printf("electron Galerkin %d flow with sensitivities, per step: engine %.0f ns, hand-written %.0f ns, ratio %.2f\n",
+              Sch::order, te / steps, th / steps, te / th);
 }
 
 void electron_paper_flow() {
@@ -179,7 +188,8 @@ void beanie_paper_step() {
 }  // namespace
 
 int main() {
-  electron_galerkin_flow();
+  electron_galerkin_flow<3>();
+  electron_galerkin_flow<4>();
   electron_paper_flow();
   beanie_galerkin_flow<3>();
   beanie_galerkin_flow<4>();

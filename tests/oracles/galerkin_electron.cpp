@@ -28,51 +28,76 @@ Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& b) {  // cross_matrix(b) y =
 //   E_x = g_{n-1,X2} + h² g_{n,x} − g_{n,X2},   E_v = g_{n-1,V1} + h g_{n,v} − g_{n,X2} − g_{n,V1},
 // i.e. E = P_prev M y_{n-1} + P_next M y_n, with y_n = (T y_{n-1}, z) (T: x_n, v_n from interval
 // n-1). E = 0 is linear in z: K z = −R y_{n-1}, K = P_next M S, R = P_prev M + P_next M T.
+//
+// Galerkin 6 (quartic, 3 Gauss points): y gains the bubble a (p += h² a β, β = τ²(1 − τ)²), and
+// interval n's bubble equation ∂L~_n/∂a = 0 joins node n's; the unknowns are (X2, V1, a).
 namespace {
+template <int S>
 struct StepSystem {
-  Eigen::PartialPivLU<Eigen::Matrix<double, 6, 6>> K;
-  Eigen::Matrix<double, 6, 12> R;
+  static constexpr int ny = 3 * (S + 1), nz = 3 * (S - 1);  // interval coordinates, unknowns
+  Eigen::PartialPivLU<Eigen::Matrix<double, nz, nz>> K;
+  Eigen::Matrix<double, nz, ny> R;
 };
 
-StepSystem step_system(const problems::ElectronModel& model, double h) {
-  if (model.quartic != 0.0) throw std::invalid_argument("electron_galerkin4 oracle: only the linear electron");
-  using Mat = Eigen::Matrix<double, 12, 12>;
+template <int S>
+StepSystem<S> step_system(const problems::ElectronModel& model, double h) {
+  static_assert(S == 3 || S == 4, "cubic or quartic");
+  if (model.quartic != 0.0) throw std::invalid_argument("electron_galerkin oracle: only the linear electron");
+  constexpr int ny = StepSystem<S>::ny, nz = StepSystem<S>::nz;
+  using Mat = Eigen::Matrix<double, ny, ny>;
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity(), C = model.e_over_c * cross_matrix(model.B);
   const double m = model.mass, k2 = 2 * model.potential;
+  // Gauss–Legendre on [0, 1]: 2 points (weights ½) or 3 (5/18, 8/18, 5/18).
+  const double q = S == 3 ? 0.5 / std::sqrt(3.0) : 0.5 * std::sqrt(0.6);
+  const double points[3] = {0.5 - q, S == 3 ? 0.5 + q : 0.5, 0.5 + q};
+  const double weights[3] = {S == 3 ? 0.5 : 5.0 / 18, S == 3 ? 0.5 : 8.0 / 18, 5.0 / 18};
   Mat M = Mat::Zero();
-  for (double sign : {-1.0, 1.0}) {
-    const double t = 0.5 + sign * 0.5 / std::sqrt(3.0), w = 0.5;
+  for (int g = 0; g < S - 1; ++g) {
+    const double t = points[g], w = weights[g];
     const double H01 = 3 * t * t - 2 * t * t * t, H11 = t * t * t - t * t;
     const double dH01 = 6 * t - 6 * t * t, dH11 = 3 * t * t - 2 * t;
     const double ddH01 = 6 - 12 * t, ddH11 = 6 * t - 2;
-    Eigen::Matrix<double, 3, 12> A;
-    A.block<3, 3>(0, 0) = k2 * I;                                                // x_n
-    A.block<3, 3>(0, 3) = k2 * h * t * I + C;                                    // v_n
-    A.block<3, 3>(0, 6) = (m * ddH01 + k2 * h * h * H01) * I + h * dH01 * C;     // X2
-    A.block<3, 3>(0, 9) = (m * ddH11 + k2 * h * h * H11) * I + h * dH11 * C;     // V1
+    Eigen::Matrix<double, 3, ny> A;
+    A.template block<3, 3>(0, 0) = k2 * I;                                                // x_n
+    A.template block<3, 3>(0, 3) = k2 * h * t * I + C;                                    // v_n
+    A.template block<3, 3>(0, 6) = (m * ddH01 + k2 * h * h * H01) * I + h * dH01 * C;     // X2
+    A.template block<3, 3>(0, 9) = (m * ddH11 + k2 * h * h * H11) * I + h * dH11 * C;     // V1
+    if constexpr (S == 4) {
+      const double B = t * t * (1 - t) * (1 - t), dB = 2 * t - 6 * t * t + 4 * t * t * t, ddB = 2 - 12 * t + 12 * t * t;
+      A.template block<3, 3>(0, 12) = (m * ddB + k2 * h * h * B) * I + h * dB * C;       // a
+    }
     M.noalias() += (h * w) * A.transpose() * A;
   }
-  Eigen::Matrix<double, 6, 12> Pprev = Eigen::Matrix<double, 6, 12>::Zero(), Pnext = Pprev;
-  Pprev.block<3, 3>(0, 6) = I, Pprev.block<3, 3>(3, 9) = I;
-  Pnext.block<3, 3>(0, 0) = h * h * I, Pnext.block<3, 3>(0, 6) = -I;
-  Pnext.block<3, 3>(3, 3) = h * I, Pnext.block<3, 3>(3, 6) = -I, Pnext.block<3, 3>(3, 9) = -I;
+  Eigen::Matrix<double, nz, ny> Pprev = Eigen::Matrix<double, nz, ny>::Zero(), Pnext = Pprev;
+  Pprev.template block<3, 3>(0, 6) = I, Pprev.template block<3, 3>(3, 9) = I;
+  Pnext.template block<3, 3>(0, 0) = h * h * I, Pnext.template block<3, 3>(0, 6) = -I;
+  Pnext.template block<3, 3>(3, 3) = h * I, Pnext.template block<3, 3>(3, 6) = -I, Pnext.template block<3, 3>(3, 9) = -I;
+  if constexpr (S == 4) Pnext.template block<3, 3>(6, 12) = I;  // interval n's bubble equation
   Mat T = Mat::Zero();  // x_n = x + h v + h² X2, v_n = v + h V1 of interval n-1
-  T.block<3, 3>(0, 0) = I, T.block<3, 3>(0, 3) = h * I, T.block<3, 3>(0, 6) = h * h * I;
-  T.block<3, 3>(3, 3) = I, T.block<3, 3>(3, 9) = h * I;
-  const Eigen::Matrix<double, 6, 12> PM = Pnext * M;
-  return {Eigen::PartialPivLU<Eigen::Matrix<double, 6, 6>>(PM.rightCols<6>()), Pprev * M + PM * T};
+  T.template block<3, 3>(0, 0) = I, T.template block<3, 3>(0, 3) = h * I, T.template block<3, 3>(0, 6) = h * h * I;
+  T.template block<3, 3>(3, 3) = I, T.template block<3, 3>(3, 9) = h * I;
+  const Eigen::Matrix<double, nz, ny> PM = Pnext * M;
+  StepSystem<S> sys;
+  sys.K.compute(PM.template rightCols<nz>());
+  sys.R = Pprev * M + PM * T;
+  return sys;
 }
 }  // namespace
 
 GalerkinElectronMap electron_galerkin4_step_map(const problems::ElectronModel& model, double h) {
-  const StepSystem sys = step_system(model, h);
+  const StepSystem<3> sys = step_system<3>(model, h);
+  return -sys.K.solve(sys.R);
+}
+
+GalerkinElectron6Map electron_galerkin6_step_map(const problems::ElectronModel& model, double h) {
+  const StepSystem<4> sys = step_system<4>(model, h);
   return -sys.K.solve(sys.R);
 }
 
 Eigen::Matrix<double, 6, 1> electron_galerkin4_step(const problems::ElectronModel& model, double h,
                                                     const GalerkinElectronState& state,
                                                     GalerkinElectronMap* sensitivity) {
-  const StepSystem sys = step_system(model, h);
+  const StepSystem<3> sys = step_system<3>(model, h);
   if (!sensitivity) return -sys.K.solve(sys.R * state);
   *sensitivity = -sys.K.solve(sys.R);
   return *sensitivity * state;

@@ -1,6 +1,7 @@
-// The electron's Galerkin 4 step (METHOD.md §9, cubic Hermite, 2 Gauss points) derived by hand:
-// the independent oracle for the engine's derived Galerkin step and its sensitivity, and the
-// hand-written baseline of bench/bench_galerkin_step.cpp. Only the linear electron (quartic = 0):
+// The electron's Galerkin 4 step (METHOD.md §9, cubic Hermite, 2 Gauss points) and Galerkin 6
+// step (below) derived by hand: the independent oracles for the engine's derived Galerkin steps
+// and their sensitivities, and the hand-written baselines of bench/bench_galerkin_step.cpp and
+// bench/bench_ratios.cpp. Only the linear electron (quartic = 0):
 // its ℓ = ½|u|² with u linear in the jet makes the step a linear map, solved in closed form.
 #pragma once
 
@@ -22,5 +23,12 @@ GalerkinElectronMap electron_galerkin4_step_map(const problems::ElectronModel& m
 Eigen::Matrix<double, 6, 1> electron_galerkin4_step(const problems::ElectronModel& model, double h,
                                                     const GalerkinElectronState& state,
                                                     GalerkinElectronMap* sensitivity = nullptr);
+
+// Galerkin 6 (quartic, one bubble a per component, 3 Gauss points): an interval's coordinates
+// (x, v, X2, V1, a) and the step (X2, V1, a) of interval n = Φ · (interval n-1), the engine's
+// ElectronGalerkin<4> layout. Requires model.quartic == 0.
+using GalerkinElectron6State = Eigen::Matrix<double, 15, 1>;
+using GalerkinElectron6Map = Eigen::Matrix<double, 9, 15>;
+GalerkinElectron6Map electron_galerkin6_step_map(const problems::ElectronModel& model, double h);
 
 }  // namespace lpshoot::oracles
